@@ -1,0 +1,18 @@
+#include "engine/error.hpp"
+
+namespace vb {
+namespace {
+std::string compose(const std::string& what, const std::string& where, const std::string& hint) {
+  std::string s = where.empty() ? what : where + ": " + what;
+  if (!hint.empty()) s += " (" + hint + ")";
+  return s;
+}
+}  // namespace
+
+Error::Error(std::string what, std::string where, std::string hint)
+    : std::runtime_error(compose(what, where, hint)),
+      problem_(std::move(what)),
+      where_(std::move(where)),
+      hint_(std::move(hint)) {}
+
+}  // namespace vb

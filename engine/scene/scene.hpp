@@ -1,0 +1,118 @@
+#pragma once
+/// The scene: everything a run simulates, in SI units, as parsed from a scene file.
+/// Absent sections stay empty/inactive so the simulator builds nothing for them.
+#include <Eigen/Core>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace vb {
+
+using Vec3 = Eigen::Vector3d;
+
+/// Analytic solid voxelised into the model; later shapes override earlier ones.
+struct ShapeSpec {
+  enum class Kind { Box, Sphere, Ellipsoid, HalfEllipsoid, Hemisphere };
+  Kind kind = Kind::Box;
+  Vec3 min_m = Vec3::Zero(), max_m = Vec3::Zero();  ///< box corners (m)
+  Vec3 center_m = Vec3::Zero();                     ///< sphere/ellipsoid centre (m)
+  Vec3 radii_m = Vec3::Zero();                      ///< ellipsoid semi-axes along x, y, z (m)
+  double radius_m = 0;                              ///< sphere/hemisphere radius (m)
+  Vec3 axis = Vec3::UnitZ();  ///< half shapes keep the side where (p - centre)·axis ≥ 0 (unit)
+  std::string label;          ///< tissue name; must name a [materials.X] table
+  int line = 0;               ///< scene-file line, for error messages
+};
+
+struct ModelSpec {
+  double spacing_m = 0;  ///< voxel edge length for analytic shapes (m)
+  int downsample = 1;    ///< merge downsample³ voxels into one element
+  std::vector<ShapeSpec> shapes;
+};
+
+/// Per-tissue material. Issue 4 adds hyperelastic laws; the core knows linear springs.
+struct MaterialSpec {
+  std::string name;
+  std::string law = "linear";
+  double youngs_modulus_pa = 0;
+  double density_kg_m3 = 1000;
+  int line = 0;
+};
+
+enum class Integrator { SymplecticEuler, Heun };
+enum class Precision { Float, Double };
+
+struct SolverSpec {
+  Integrator integrator = Integrator::Heun;
+  std::optional<double> dt_s;       ///< empty: "auto" (stable step from the stiffest mode)
+  double dt_safety = 0.5;           ///< fraction of the stability limit that "auto" uses
+  Precision precision = Precision::Float;
+  double damping_per_s = 0;         ///< global mass-proportional viscous damping γ (1/s): f = -mγv
+  double dashpot_ratio = 0.1;       ///< connection dashpot damping ratio ζ: c = 2ζ√(k·m_reduced)
+  int check_every = 100;            ///< steps between equilibrium/instability checks
+};
+
+struct GravitySpec {
+  bool active = false;
+  Vec3 acceleration_m_s2 = Vec3::Zero();
+  std::string posture;  ///< posture name when given by name (supine, prone, ...), else empty
+};
+
+struct AnchorSpec {
+  enum class Kind { Sphere, HalfSpace, Box };
+  std::string name;
+  Kind kind = Kind::Sphere;
+  Vec3 center_m = Vec3::Zero();
+  double radius_m = 0;
+  Vec3 rpy_deg = Vec3::Zero();  ///< sphere pose: roll (x), pitch (y), yaw (z) about the centre (deg)
+  Vec3 point_m = Vec3::Zero();  ///< half-space: a point on the plane (m)
+  Vec3 normal = Vec3::UnitZ();  ///< half-space: elements with (p - point)·normal ≥ 0 are held
+  Vec3 min_m = Vec3::Zero(), max_m = Vec3::Zero();  ///< box region (m)
+  int line = 0;
+};
+
+/// Rigid indenter moved at constant velocity; pushes (frictionless) the elements it touches.
+struct IndenterSpec {
+  enum class Kind { Sphere, Plate };
+  Kind kind = Kind::Sphere;
+  double radius_m = 0;               ///< sphere radius (m)
+  Vec3 start_m = Vec3::Zero();       ///< sphere centre / a point on the plate at t = 0 (m)
+  Vec3 normal = Vec3::UnitZ();       ///< plate: unit normal pointing from the plate into the tissue
+  Vec3 velocity_m_s = Vec3::Zero();  ///< (m/s)
+  double travel_time_s = std::numeric_limits<double>::infinity();  ///< stops moving after this
+  int line = 0;
+};
+
+struct TrackSpec {
+  std::string name;
+  Vec3 point_m = Vec3::Zero();
+  int line = 0;
+};
+
+struct StopSpec {
+  double equilibrium = 1e-6;  ///< relative tolerance (see docs/SCENE.md); 0 disables
+  std::int64_t max_steps = 200000;
+  double max_time_s = std::numeric_limits<double>::infinity();
+};
+
+struct OutputSpec {
+  int frames_every = 0;  ///< store displacement frames every N steps in result.h5 (0: none)
+};
+
+struct Scene {
+  ModelSpec model;
+  std::map<std::string, MaterialSpec> materials;
+  SolverSpec solver;
+  GravitySpec gravity;
+  std::vector<AnchorSpec> anchors;
+  std::vector<IndenterSpec> indenters;
+  std::vector<TrackSpec> tracks;
+  StopSpec stop;
+  OutputSpec output;
+  std::string source_path;  ///< file the scene came from (for messages)
+  std::string source_text;  ///< the scene file text, stored with results
+};
+
+}  // namespace vb
