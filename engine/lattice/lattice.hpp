@@ -41,6 +41,8 @@ struct Lattice {
   Eigen::Vector3d rest_position(std::size_t element) const;
   /// voxel index → world transform (4×4, m), voxel centres at integer indices
   Eigen::Matrix4d affine() const;
+  /// element index of each of the 26 neighbours (neighbour_offsets() order), -1 where empty
+  std::array<std::int32_t, 26> neighbours(std::size_t element) const;
 };
 
 /// The 26 neighbour offsets, ordered: 6 face, 12 edge (face diagonal), 8 corner (body diagonal).

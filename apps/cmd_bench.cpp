@@ -1,0 +1,173 @@
+// voxbreast bench [--quick] --out DIR — steps/s of standard models on this device, and the
+// device's copy bandwidth measured in the same run. Writes bench.json and bench.csv.
+//   voxbreast bench --quick --out out/bench
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "apps/commands.hpp"
+#include "engine/lattice/lattice.hpp"
+#include "engine/lattice/voxelise.hpp"
+#include "engine/sim/simulator.hpp"
+#include "io/atomic_file.hpp"
+#include "voxbreast/config.hpp"
+
+namespace vb::app {
+namespace {
+
+struct BenchOptions {
+  std::string out, device;
+  bool quick = false;
+  std::vector<int> sizes;  ///< block edge lengths in elements
+};
+
+struct BenchCase {
+  std::string name;
+  int edge = 0;
+  Integrator integrator = Integrator::Heun;
+  Precision precision = Precision::Float;
+};
+
+/// A cube of `edge`³ adipose elements, base held, under gravity: the standard linear block.
+Scene block_scene(const BenchCase& c) {
+  Scene s;
+  const double h = 0.002;
+  ShapeSpec box;
+  box.kind = ShapeSpec::Kind::Box;
+  box.min_m = Vec3::Zero();
+  box.max_m = Vec3::Constant(c.edge * h);
+  box.label = "adipose";
+  s.model.spacing_m = h;
+  s.model.shapes.push_back(box);
+  MaterialSpec m;
+  m.name = "adipose";
+  m.youngs_modulus_pa = 3000;
+  s.materials["adipose"] = m;
+  s.solver.integrator = c.integrator;
+  s.solver.precision = c.precision;
+  s.solver.damping_per_s = 5;
+  s.gravity.active = true;
+  s.gravity.acceleration_m_s2 = Vec3(0, 0, -9.80665);
+  AnchorSpec base;
+  base.name = "base";
+  base.kind = AnchorSpec::Kind::HalfSpace;
+  base.point_m = Vec3(0, 0, h);
+  base.normal = Vec3(0, 0, -1);
+  s.anchors.push_back(base);
+  return s;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Steps per second, timed over enough steps to last about `target_s`.
+double time_steps(Simulator& sim, double target_s) {
+  sim.advance(3);
+  sim.check();  // warm-up, includes any lazy compilation
+  std::int64_t steps = 4;
+  for (;;) {
+    const auto t0 = std::chrono::steady_clock::now();
+    sim.advance(steps);
+    sim.context().queue.finish();
+    const double t = seconds_since(t0);
+    if (t >= target_s || steps >= (1 << 22)) return double(steps) / t;
+    steps = std::int64_t(std::ceil(double(steps) * std::min(8.0, 1.2 * target_s / std::max(t, 1e-6))));
+  }
+}
+
+/// Achievable device bandwidth (bytes/s): read + write of a large buffer.
+double copy_bandwidth(const ClContext& cl, std::size_t bytes) {
+  cl::Program p = build_program(cl, {"common.cl", "bandwidth.cl"}, "", "-DVB_DOUBLE=0");
+  cl::Kernel k(p, "copy_bandwidth");
+  const std::size_t n = bytes / 16;
+  cl::Buffer a(cl.context, CL_MEM_READ_WRITE, n * 16), b(cl.context, CL_MEM_READ_WRITE, n * 16);
+  cl.queue.enqueueFillBuffer(a, cl_float(1), 0, n * 16);
+  k.setArg(0, a); k.setArg(1, b); k.setArg(2, cl_uint(n));
+  const cl::NDRange global((n + 255) / 256 * 256);
+  cl.queue.enqueueNDRangeKernel(k, cl::NullRange, global);
+  cl.queue.finish();
+  const int reps = 10;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int r = 0; r < reps; ++r) cl.queue.enqueueNDRangeKernel(k, cl::NullRange, global);
+  cl.queue.finish();
+  return 2.0 * double(n * 16) * reps / seconds_since(t0);
+}
+
+/// Bytes a Heun step must move per element, counting each element's own state once per stage
+/// (neighbour reads are served from cache): stage 1 reads u, v, E, cell, grid and writes ũ, ṽ;
+/// stage 2 reads u, v, ũ, ṽ, E, cell, grid and writes u, v.
+double heun_bytes_per_element(std::size_t real_size) {
+  const double vec = 4.0 * double(real_size), scalar = double(real_size), idx = 4.0;
+  return (2 * vec + scalar + 2 * idx + 2 * vec) + (4 * vec + scalar + 2 * idx + 2 * vec);
+}
+
+int run_bench(const BenchOptions& o) {
+  ensure_output_dir(o.out);
+  const ClContext cl(select_device(o.device));
+  std::vector<int> sizes = o.sizes;
+  if (sizes.empty()) sizes = {33, 115};  // 35,937 and 1,520,875 elements
+  const double target_s = o.quick ? 0.5 : 2.0;
+  const double bandwidth = copy_bandwidth(cl, std::min<std::size_t>(cl.info.max_allocation_bytes / 2, o.quick ? 64u << 20 : 512u << 20));
+  std::printf("device: %s (%s)\ncopy bandwidth: %.1f GB/s\n", cl.info.name.c_str(), cl.info.platform.c_str(), bandwidth / 1e9);
+
+  std::vector<BenchCase> cases;
+  for (int edge : sizes) {
+    cases.push_back({"block", edge, Integrator::Heun, Precision::Float});
+    if (!o.quick) {
+      cases.push_back({"block", edge, Integrator::SymplecticEuler, Precision::Float});
+      if (cl.info.fp64) cases.push_back({"block", edge, Integrator::Heun, Precision::Double});
+    }
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  std::ostringstream csv;
+  csv << "model,elements,law,integrator,precision,steps_per_s,ns_per_element_step,bytes_per_element_step,"
+         "effective_bandwidth_gb_s,fraction_of_copy_bandwidth,device_bytes_per_element\n";
+  for (const BenchCase& c : cases) {
+    const Scene scene = block_scene(c);
+    const Lattice lattice = build_lattice(voxelise_shapes(scene));
+    const ElementArrays el = make_element_arrays(scene, lattice);
+    Simulator sim(scene, lattice, el, cl);
+    const double sps = time_steps(sim, target_s);
+    const std::size_t n = lattice.element_count();
+    const std::size_t real_size = c.precision == Precision::Double ? 8 : 4;
+    const bool heun = c.integrator == Integrator::Heun;
+    const double bytes = heun ? heun_bytes_per_element(real_size) : heun_bytes_per_element(real_size) / 2;
+    const double effective = bytes * double(n) * sps;
+    const char* integ = heun ? "heun" : "symplectic_euler";
+    const char* prec = c.precision == Precision::Double ? "double" : "float";
+    std::printf("%-6s %9zu elements  linear  %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
+                c.name.c_str(), n, integ, prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
+    rows.push_back({{"model", c.name}, {"elements", n}, {"law", "linear"}, {"integrator", integ}, {"precision", prec},
+                    {"steps_per_s", sps}, {"bytes_per_element_step", bytes}, {"effective_bandwidth_gb_s", effective / 1e9},
+                    {"fraction_of_copy_bandwidth", effective / bandwidth},
+                    {"device_bytes_per_element", double(sim.device_bytes()) / double(n)}});
+    csv << c.name << "," << n << ",linear," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
+        << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
+        << "\n";
+  }
+  nlohmann::json doc = {{"device", cl.info.name}, {"platform", cl.info.platform}, {"driver", cl.info.driver},
+                        {"copy_bandwidth_gb_s", bandwidth / 1e9}, {"quick", o.quick},
+                        {"voxbreast_version", config::version}, {"git_commit", config::git_commit}, {"results", rows}};
+  write_text_atomically(o.out + "/bench.json", doc.dump(2) + "\n");
+  write_text_atomically(o.out + "/bench.csv", csv.str());
+  std::printf("wrote %s/bench.json\nwrote %s/bench.csv\n", o.out.c_str(), o.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Command add_bench(CLI::App& app) {
+  auto o = std::make_shared<BenchOptions>();
+  auto* sub = app.add_subcommand("bench", "Measure steps/s of standard models and the device bandwidth");
+  sub->add_option("--out,-o", o->out, "output folder")->required();
+  sub->add_option("--device,-d", o->device, "OpenCL device: gpu, cpu, an index or a name");
+  sub->add_flag("--quick", o->quick, "short timings, Heun + float only");
+  sub->add_option("--sizes", o->sizes, "block edge lengths in elements (default 33 115)")->check(CLI::Range(2, 1000));
+  return {sub, [o] { return run_bench(*o); }};
+}
+
+}  // namespace vb::app

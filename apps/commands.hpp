@@ -1,0 +1,18 @@
+#pragma once
+/// The voxbreast subcommands: each registers its options on the CLI and runs when chosen.
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace vb::app {
+
+/// A registered subcommand and what runs it (after parsing); run returns the exit code.
+struct Command {
+  CLI::App* sub = nullptr;
+  std::function<int()> run;
+};
+
+Command add_info(CLI::App& app);
+Command add_simulate(CLI::App& app);
+Command add_bench(CLI::App& app);
+
+}  // namespace vb::app

@@ -1,0 +1,42 @@
+// voxbreast — CT-based, GPU-simulated breast biomechanics.
+//
+// Usage:
+//   voxbreast info
+//   voxbreast simulate data-samples/breast_phantom.toml --out out/phantom
+//   voxbreast bench --quick --out out/bench
+// Every subcommand has --help. Errors print one line naming the problem and exit non-zero.
+#include <CL/opencl.hpp>
+#include <cstdio>
+
+#include "apps/commands.hpp"
+#include "engine/error.hpp"
+#include "engine/sim/opencl_runtime.hpp"
+#include "voxbreast/config.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"VoxBreast: voxel-lattice breast biomechanics on OpenCL devices"};
+  app.set_version_flag("--version", std::string(vb::config::version) + " (" + vb::config::git_commit + ")");
+  app.require_subcommand(1);
+  const vb::app::Command commands[] = {vb::app::add_info(app), vb::app::add_simulate(app),
+                                       vb::app::add_bench(app)};
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    for (const auto& command : commands)
+      if (command.sub->parsed()) return command.run();
+  } catch (const vb::Error& e) {
+    std::fprintf(stderr, "voxbreast: error: %s\n", e.what());
+    return 1;
+  } catch (const cl::Error& e) {
+    std::fprintf(stderr, "voxbreast: error: OpenCL call %s failed: %s\n", e.what(),
+                 vb::cl_status_name(e.err()).c_str());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "voxbreast: error: %s\n", e.what());
+    return 1;
+  }
+  return 1;
+}

@@ -1,0 +1,13 @@
+#pragma once
+/// Analytic shapes → labelled voxel volume.
+#include "engine/lattice/lattice.hpp"
+#include "engine/scene/scene.hpp"
+
+namespace vb {
+
+/// Voxelises the scene's shapes at model.spacing_m. Voxel centres sit at (n + ½)·h on a world-
+/// aligned grid; a voxel takes the label of the last shape containing its centre. Tissue names
+/// are the shapes' labels in order of first appearance.
+LabelVolume voxelise_shapes(const Scene& scene);
+
+}  // namespace vb

@@ -1,0 +1,45 @@
+#include "engine/sim/element_setup.hpp"
+
+#include <cmath>
+
+#include "engine/error.hpp"
+#include "engine/loads/anchors.hpp"
+
+namespace vb {
+
+ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
+  const std::size_t n = lattice.element_count();
+  require(n > 0, "the model has no elements", "model", "check the shapes, labels and downsample factor");
+  const double volume = std::pow(lattice.spacing_m, 3);
+
+  std::vector<double> E_of_tissue, mass_of_tissue;
+  for (const std::string& tissue : lattice.tissue_names) {
+    auto it = scene.materials.find(tissue);
+    require(it != scene.materials.end(), "tissue '" + tissue + "' has no material", "materials." + tissue);
+    const MaterialSpec& m = it->second;
+    const std::string where = "materials." + tissue + (m.line ? " (line " + std::to_string(m.line) + ")" : "");
+    require(m.youngs_modulus_pa > 0 && std::isfinite(m.youngs_modulus_pa), "Young's modulus must be positive", where);
+    require(m.density_kg_m3 > 0 && std::isfinite(m.density_kg_m3), "density must be positive", where);
+    E_of_tissue.push_back(m.youngs_modulus_pa);
+    mass_of_tissue.push_back(m.density_kg_m3 * volume);
+  }
+
+  ElementArrays a;
+  a.youngs_modulus_pa.resize(n);
+  a.mass_kg.resize(n);
+  a.inverse_mass.resize(n);
+  a.displacement_m.assign(3 * n, 0.0);
+  const AnchorPlacement anchors = place_anchors(lattice, scene.anchors);
+  for (std::size_t e = 0; e < n; ++e) {
+    const int t = lattice.tissue_of_element[e];
+    a.youngs_modulus_pa[e] = E_of_tissue[t];
+    a.mass_kg[e] = mass_of_tissue[t];
+    a.inverse_mass[e] = anchors.held[e] ? 0.0 : 1.0 / mass_of_tissue[t];
+    for (int c = 0; c < 3; ++c) a.displacement_m[3 * e + c] = anchors.displacement_m[e][c];
+    a.held_count += anchors.held[e];
+  }
+  require(a.held_count < n || n == 0, "every element is held by an anchor; nothing can move", "anchor");
+  return a;
+}
+
+}  // namespace vb

@@ -1,0 +1,95 @@
+#include "engine/sim/host_reference.hpp"
+
+#include <cmath>
+
+#include "engine/material/linear_spring.hpp"
+
+namespace vb {
+
+std::array<double, 26> connection_stiffness(const Lattice& lattice, const std::vector<double>& E,
+                                            std::size_t e) {
+  const auto nb = lattice.neighbours(e);
+  std::array<double, 26> k{};
+  for (int d = 0; d < 26; ++d)
+    if (nb[d] >= 0) k[d] = linear_spring::stiffness(d, lattice.spacing_m, E[e], E[nb[d]]);
+  return k;
+}
+
+HostReference::HostReference(const Lattice& lattice, const ElementArrays& elements, const Scene& scene)
+    : u(elements.displacement_m),
+      v(elements.displacement_m.size(), 0.0),
+      lattice_(lattice),
+      el_(elements),
+      gravity_(scene.gravity.active ? scene.gravity.acceleration_m_s2 : Vec3::Zero()),
+      damping_(scene.solver.damping_per_s),
+      dashpot_ratio_(scene.solver.dashpot_ratio),
+      integrator_(scene.solver.integrator) {
+  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+    neighbours_.push_back(lattice.neighbours(e));
+    stiffness_.push_back(connection_stiffness(lattice, elements.youngs_modulus_pa, e));
+  }
+}
+
+std::vector<double> HostReference::lattice_forces(const std::vector<double>& u,
+                                                  const std::vector<double>& v) const {
+  const std::size_t n = lattice_.element_count();
+  const auto& offsets = neighbour_offsets();
+  const double h = lattice_.spacing_m;
+  std::vector<double> f(3 * n, 0.0);
+  for (std::size_t e = 0; e < n; ++e) {
+    const Vec3 ue(u[3 * e], u[3 * e + 1], u[3 * e + 2]), ve(v[3 * e], v[3 * e + 1], v[3 * e + 2]);
+    Vec3 fe = Vec3::Zero();
+    for (int d = 0; d < 26; ++d) {
+      const double k = stiffness_[e][d];
+      if (k == 0) continue;
+      const std::size_t j = neighbours_[e][d];
+      const Vec3 uj(u[3 * j], u[3 * j + 1], u[3 * j + 2]), vj(v[3 * j], v[3 * j + 1], v[3 * j + 2]);
+      const Vec3 r = h * Vec3(offsets[d][0], offsets[d][1], offsets[d][2]) + (uj - ue);
+      const double len = r.norm();
+      const Vec3 nrm = r / len;
+      double magnitude = k * (len - h * linear_spring::rest_length_factor(d));
+      const double inv_mass_sum = el_.inverse_mass[e] + el_.inverse_mass[j];
+      if (dashpot_ratio_ > 0 && inv_mass_sum > 0)
+        magnitude += 2 * dashpot_ratio_ * std::sqrt(k / inv_mass_sum) * (vj - ve).dot(nrm);
+      fe += magnitude * nrm;
+    }
+    for (int c = 0; c < 3; ++c) f[3 * e + c] = fe[c];
+  }
+  return f;
+}
+
+std::vector<double> HostReference::acceleration(const std::vector<double>& u,
+                                                const std::vector<double>& v) const {
+  std::vector<double> a = lattice_forces(u, v);
+  for (std::size_t e = 0; e < lattice_.element_count(); ++e)
+    for (int c = 0; c < 3; ++c) {
+      double& ac = a[3 * e + c];
+      ac = el_.inverse_mass[e] == 0 ? 0.0 : ac * el_.inverse_mass[e] + gravity_[c] - damping_ * v[3 * e + c];
+    }
+  return a;
+}
+
+void HostReference::step(double dt, int steps) {
+  for (int s = 0; s < steps; ++s) {
+    const std::vector<double> a = acceleration(u, v);
+    if (integrator_ == Integrator::SymplecticEuler) {
+      for (std::size_t i = 0; i < u.size(); ++i) {
+        v[i] += dt * a[i];
+        u[i] += dt * v[i];
+      }
+      continue;
+    }
+    std::vector<double> up(u.size()), vp(v.size());
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      up[i] = u[i] + dt * v[i];
+      vp[i] = v[i] + dt * a[i];
+    }
+    const std::vector<double> ap = acceleration(up, vp);
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      u[i] += 0.5 * dt * (v[i] + vp[i]);
+      v[i] += 0.5 * dt * (a[i] + ap[i]);
+    }
+  }
+}
+
+}  // namespace vb

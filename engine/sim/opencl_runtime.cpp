@@ -1,0 +1,185 @@
+#include "engine/sim/opencl_runtime.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+#include "engine/error.hpp"
+
+namespace vb::kernels {
+const std::vector<std::pair<const char*, const char*>>& embedded_sources();
+}
+
+namespace vb {
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+std::string trim(std::string s) {
+  while (!s.empty() && (s.back() == '\0' || std::isspace(static_cast<unsigned char>(s.back())))) s.pop_back();
+  return s;
+}
+
+DeviceInfo describe(const cl::Platform& platform, const cl::Device& d, int index) {
+  DeviceInfo info;
+  info.index = index;
+  info.device = d;
+  info.platform = trim(platform.getInfo<CL_PLATFORM_NAME>());
+  info.name = trim(d.getInfo<CL_DEVICE_NAME>());
+  info.vendor = trim(d.getInfo<CL_DEVICE_VENDOR>());
+  info.version = trim(d.getInfo<CL_DEVICE_VERSION>());
+  info.driver = trim(d.getInfo<CL_DRIVER_VERSION>());
+  info.is_gpu = (d.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU) != 0;
+  info.fp64 = d.getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>() != 0;
+  info.global_memory_bytes = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+  info.max_allocation_bytes = d.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+  info.compute_units = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
+  return info;
+}
+
+}  // namespace
+
+std::vector<DeviceInfo> list_devices() {
+  std::vector<cl::Platform> platforms;
+  // clGetPlatformIDs reports CL_PLATFORM_NOT_FOUND_KHR (-1001) when no ICD is installed.
+  cl_uint count = 0;
+  const cl_int status = clGetPlatformIDs(0, nullptr, &count);
+  require(status == CL_SUCCESS && count > 0,
+          "no OpenCL platform found (status " + cl_status_name(status) + ")", "OpenCL",
+          "install an OpenCL driver, e.g. pocl-opencl-icd (scripts/setup.sh does)");
+  cl::Platform::get(&platforms);
+  std::vector<DeviceInfo> out;
+  for (const auto& p : platforms) {
+    std::vector<cl::Device> devices;
+    try {
+      p.getDevices(CL_DEVICE_TYPE_ALL, &devices);
+    } catch (const cl::Error&) {
+      continue;  // a platform with no devices is not an error
+    }
+    for (const auto& d : devices) out.push_back(describe(p, d, int(out.size())));
+  }
+  require(!out.empty(), "no OpenCL device found", "OpenCL", "install an OpenCL driver");
+  return out;
+}
+
+DeviceInfo select_device(const std::string& selector_in) {
+  std::string selector = selector_in;
+  if (selector.empty())
+    if (const char* env = std::getenv("VOXBREAST_DEVICE")) selector = env;
+  const auto devices = list_devices();
+  const std::string sel = lower(selector);
+  auto first = [&](const std::function<bool(const DeviceInfo&)>& pred) -> const DeviceInfo* {
+    auto it = std::find_if(devices.begin(), devices.end(), pred);
+    return it == devices.end() ? nullptr : &*it;
+  };
+  const DeviceInfo* pick = nullptr;
+  if (sel.empty()) {
+    pick = first([](const DeviceInfo& d) { return d.is_gpu; });
+    if (!pick) pick = &devices.front();
+  } else if (sel == "gpu" || sel == "cpu") {
+    const bool gpu = sel == "gpu";
+    pick = first([&](const DeviceInfo& d) { return d.is_gpu == gpu; });
+  } else if (std::all_of(sel.begin(), sel.end(), ::isdigit)) {
+    const int index = std::stoi(sel);
+    if (index < int(devices.size())) pick = &devices[index];
+  } else {
+    pick = first([&](const DeviceInfo& d) {
+      return lower(d.name).find(sel) != std::string::npos ||
+             lower(d.platform).find(sel) != std::string::npos;
+    });
+  }
+  if (!pick) {
+    std::string names;
+    for (const auto& d : devices) names += (names.empty() ? "" : ", ") + std::to_string(d.index) + ": " + d.name;
+    throw Error("no OpenCL device matches '" + selector + "'", "--device / VOXBREAST_DEVICE",
+                "available: " + names);
+  }
+  return *pick;
+}
+
+ClContext::ClContext(const DeviceInfo& device)
+    : info(device), context(device.device), queue(context, device.device) {}
+
+const char* embedded_kernel(const std::string& file_name) {
+  for (const auto& [name, text] : kernels::embedded_sources())
+    if (file_name == name) return text;
+  throw Error("no embedded kernel named '" + file_name + "'");
+}
+
+cl::Program build_program(const ClContext& cl, const std::vector<std::string>& files,
+                          const std::string& prelude_after_first, const std::string& options) {
+  std::string source;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    source += "#line 1 \"kernels/" + files[i] + "\"\n";
+    source += embedded_kernel(files[i]);
+    source += "\n";
+    if (i == 0 && !prelude_after_first.empty()) source += "#line 1 \"generated\"\n" + prelude_after_first;
+  }
+  if (const char* dir = std::getenv("VOXBREAST_DUMP_KERNELS")) {
+    std::filesystem::create_directories(dir);
+    std::ofstream(std::filesystem::path(dir) / "program.cl") << "// options: " << options << "\n" << source;
+  }
+  cl::Program program(cl.context, source);
+  try {
+    program.build({cl.info.device}, options.c_str());
+  } catch (const cl::Error& e) {
+    std::string log;
+    try {
+      log = program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(cl.info.device);
+    } catch (const cl::Error&) {
+      log = "(no build log available)";
+    }
+    throw Error("OpenCL kernel build failed (" + cl_status_name(e.err()) + ") with options '" + options +
+                    "':\n" + trim(log),
+                cl.info.name, "set VOXBREAST_DUMP_KERNELS=DIR to write the full source");
+  }
+  return program;
+}
+
+std::string cl_status_name(int status) {
+  switch (status) {
+#define VB_CASE(x) \
+  case x:          \
+    return #x;
+    VB_CASE(CL_SUCCESS)
+    VB_CASE(CL_DEVICE_NOT_FOUND)
+    VB_CASE(CL_DEVICE_NOT_AVAILABLE)
+    VB_CASE(CL_COMPILER_NOT_AVAILABLE)
+    VB_CASE(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+    VB_CASE(CL_OUT_OF_RESOURCES)
+    VB_CASE(CL_OUT_OF_HOST_MEMORY)
+    VB_CASE(CL_BUILD_PROGRAM_FAILURE)
+    VB_CASE(CL_INVALID_VALUE)
+    VB_CASE(CL_INVALID_DEVICE)
+    VB_CASE(CL_INVALID_CONTEXT)
+    VB_CASE(CL_INVALID_COMMAND_QUEUE)
+    VB_CASE(CL_INVALID_MEM_OBJECT)
+    VB_CASE(CL_INVALID_BUILD_OPTIONS)
+    VB_CASE(CL_INVALID_PROGRAM)
+    VB_CASE(CL_INVALID_PROGRAM_EXECUTABLE)
+    VB_CASE(CL_INVALID_KERNEL_NAME)
+    VB_CASE(CL_INVALID_KERNEL)
+    VB_CASE(CL_INVALID_ARG_INDEX)
+    VB_CASE(CL_INVALID_ARG_VALUE)
+    VB_CASE(CL_INVALID_ARG_SIZE)
+    VB_CASE(CL_INVALID_KERNEL_ARGS)
+    VB_CASE(CL_INVALID_WORK_GROUP_SIZE)
+    VB_CASE(CL_INVALID_WORK_ITEM_SIZE)
+    VB_CASE(CL_INVALID_GLOBAL_OFFSET)
+    VB_CASE(CL_INVALID_BUFFER_SIZE)
+    VB_CASE(CL_INVALID_GLOBAL_WORK_SIZE)
+#undef VB_CASE
+    case -1001:
+      return "CL_PLATFORM_NOT_FOUND_KHR";
+    default:
+      return "OpenCL status " + std::to_string(status);
+  }
+}
+
+}  // namespace vb

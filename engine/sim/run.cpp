@@ -1,0 +1,144 @@
+#include "engine/sim/run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "engine/error.hpp"
+#include "engine/results/element_measures.hpp"
+
+namespace vb {
+namespace {
+
+const char* integrator_name(Integrator i) { return i == Integrator::Heun ? "heun" : "symplectic_euler"; }
+
+[[noreturn]] void report_instability(const Lattice& lattice, const Simulator& sim, const StateCheck& c,
+                                     const std::string& what) {
+  std::ostringstream msg;
+  msg << "simulation went unstable at step " << sim.steps() << " (t = " << sim.time_s() << " s): " << what;
+  if (c.fastest_element >= 0) {
+    const auto ijk = lattice.voxel_ijk(std::size_t(c.fastest_element));
+    msg << " at element " << c.fastest_element << " (voxel " << ijk[0] << "," << ijk[1] << "," << ijk[2] << ")";
+  }
+  std::ostringstream hint;
+  hint << "use a smaller solver.dt (now " << sim.dt_s() << " s; estimated stable limit "
+       << sim.time_step().stable_limit_s << " s) or more damping";
+  throw Error(msg.str(), "solver", hint.str());
+}
+
+}  // namespace
+
+std::pair<double, double> equilibrium_scales(const Lattice& lattice, const ElementArrays& el) {
+  const double E_max = *std::max_element(el.youngs_modulus_pa.begin(), el.youngs_modulus_pa.end());
+  const double m_min = *std::min_element(el.mass_kg.begin(), el.mass_kg.end());
+  const double h = lattice.spacing_m;
+  return {E_max * h * h, std::sqrt(E_max / (m_min / (h * h * h)))};
+}
+
+std::size_t nearest_element(const Lattice& lattice, const Vec3& p) {
+  std::size_t best = 0;
+  double best_d2 = INFINITY;
+  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+    const double d2 = (lattice.rest_position(e) - p).squaredNorm();
+    if (d2 < best_d2) best_d2 = d2, best = e;
+  }
+  return best;
+}
+
+RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const ElementArrays& el, Simulator& sim,
+                         const std::function<void(const RunProgress&)>& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto [F_ref, wave_speed] = equilibrium_scales(lattice, el);
+  const double h = lattice.spacing_m;
+  const double extent = h * Eigen::Vector3d(lattice.dims[0], lattice.dims[1], lattice.dims[2]).norm();
+  const double tol = scene.stop.equilibrium;
+  const double travel_end = scene.indenters.empty() ? 0.0 : scene.indenters.front().travel_time_s;
+  const std::int64_t check_every = std::max(1, scene.solver.check_every);
+  const std::int64_t frames_every = scene.output.frames_every;
+  std::int64_t max_steps = scene.stop.max_steps;
+  if (std::isfinite(scene.stop.max_time_s))
+    max_steps = std::min<std::int64_t>(max_steps, std::int64_t(std::ceil(scene.stop.max_time_s / sim.dt_s() - 1e-9)));
+
+  RunOutput out;
+  RunSummary& s = out.summary;
+  StateCheck c;
+  s.stop_reason = "max_steps";
+  for (;;) {
+    std::int64_t chunk = std::min(check_every, max_steps - sim.steps());
+    if (frames_every > 0) chunk = std::min(chunk, frames_every - sim.steps() % frames_every);
+    sim.advance(chunk);
+    c = sim.check();
+    if (c.nonfinite_elements > 0)
+      report_instability(lattice, sim, c, std::to_string(c.nonfinite_elements) + " elements have non-finite state");
+    if (c.max_speed_m_s * sim.dt_s() > 0.5 * h)
+      report_instability(lattice, sim, c, "an element moves more than half a spacing per step");
+    if (c.max_displacement_m > 10 * extent)
+      report_instability(lattice, sim, c, "displacement exceeds ten times the model size");
+
+    s.final_residual = c.max_residual_n / F_ref;
+    s.final_speed_ratio = c.max_speed_m_s / wave_speed;
+    if (frames_every > 0 && sim.steps() % frames_every == 0) {
+      std::vector<double> u, v;
+      sim.download(u, v);
+      out.frames.time_s.push_back(sim.time_s());
+      out.frames.displacement_m.emplace_back(u.begin(), u.end());
+    }
+    if (!scene.indenters.empty()) {
+      IndenterResult& ir = s.indenters.empty() ? s.indenters.emplace_back() : s.indenters.front();
+      const Vec3 pos = sim.indenter_position(sim.time_s());
+      ir.position_m = pos;
+      ir.reaction_force_n = c.indenter_force_n;
+      ir.contact_elements = c.contact_elements;
+      const double travel = (pos - scene.indenters.front().start_m).norm();
+      ir.history.push_back({sim.time_s(), c.indenter_force_n.x(), c.indenter_force_n.y(), c.indenter_force_n.z(), travel});
+    }
+    if (progress) progress({sim.steps(), max_steps, sim.time_s(), s.final_residual, s.final_speed_ratio});
+    const bool settled = tol > 0 && s.final_residual <= tol && s.final_speed_ratio <= tol && sim.time_s() >= travel_end;
+    if (settled) {
+      s.converged = true;
+      s.stop_reason = "equilibrium";
+      break;
+    }
+    if (sim.steps() >= max_steps) {
+      if (sim.steps() < scene.stop.max_steps) s.stop_reason = "max_time";
+      break;
+    }
+  }
+  s.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  FinalState& st = out.state;
+  sim.download(st.displacement_m, st.velocity_m_s);
+  const std::size_t n = lattice.element_count();
+  st.position_m.resize(3 * n);
+  for (std::size_t e = 0; e < n; ++e) {
+    const Vec3 X = lattice.rest_position(e);
+    for (int k = 0; k < 3; ++k) st.position_m[3 * e + k] = X[k] + st.displacement_m[3 * e + k];
+  }
+  s.volume_change = compute_element_measures(lattice, el.youngs_modulus_pa, st);
+
+  s.elements = n;
+  s.connections = lattice.connection_count;
+  s.fixed_elements = el.held_count;
+  s.steps = sim.steps();
+  s.dt_s = sim.dt_s();
+  s.dt_auto = sim.time_step().automatic;
+  s.simulated_time_s = sim.time_s();
+  s.steps_per_second = s.wall_time_s > 0 ? double(s.steps) / s.wall_time_s : 0;
+  s.max_displacement_m = c.max_displacement_m;
+  s.device_name = sim.context().info.name;
+  s.precision = sim.precision() == Precision::Double ? "double" : "float";
+  s.integrator = integrator_name(scene.solver.integrator);
+  for (const TrackSpec& t : scene.tracks) {
+    TrackedPointResult r;
+    r.name = t.name;
+    r.point_m = t.point_m;
+    r.element = std::int64_t(nearest_element(lattice, t.point_m));
+    r.rest_m = lattice.rest_position(std::size_t(r.element));
+    for (int k = 0; k < 3; ++k) r.displacement_m[k] = st.displacement_m[3 * r.element + k];
+    s.tracked.push_back(r);
+  }
+  return out;
+}
+
+}  // namespace vb

@@ -1,0 +1,36 @@
+#pragma once
+/// The run loop around the simulator: stepping in chunks between device checks, stopping rules
+/// (equilibrium, max steps, simulated time), blow-up detection, frames, and the final results.
+#include <functional>
+
+#include "engine/sim/run_result.hpp"
+#include "engine/sim/simulator.hpp"
+
+namespace vb {
+
+struct RunProgress {
+  std::int64_t step = 0, max_steps = 0;
+  double time_s = 0;
+  double residual = 0;     ///< max residual force / F_ref
+  double speed_ratio = 0;  ///< max speed / elastic wave speed
+};
+
+struct RunOutput {
+  RunSummary summary;
+  FinalState state;
+  Frames frames;
+};
+
+/// Runs to a stopping rule. Throws vb::Error (with step, element and a smaller-dt hint) when the
+/// state stops being finite or an element moves more than half a spacing in one step.
+RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const ElementArrays& elements,
+                         Simulator& sim, const std::function<void(const RunProgress&)>& progress = {});
+
+/// Reference force F_ref = E_max·h² (N) and wave speed c = √(E_max/ρ_min) (m/s) of the
+/// equilibrium criterion (docs/SCENE.md).
+std::pair<double, double> equilibrium_scales(const Lattice& lattice, const ElementArrays& elements);
+
+/// Element nearest to a world point (m).
+std::size_t nearest_element(const Lattice& lattice, const Vec3& point_m);
+
+}  // namespace vb

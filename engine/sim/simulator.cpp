@@ -1,0 +1,315 @@
+#include "engine/sim/simulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/error.hpp"
+#include "engine/sim/kernel_tables.hpp"
+
+namespace vb {
+namespace {
+
+constexpr int kCheckWorkGroup = 128;
+constexpr int kCheckSlots = 9;  // must match VB_CHECK_SLOTS in kernels/checks.cl
+
+template <typename T>
+std::vector<T> pack4(const std::vector<double>& xyz, const std::vector<double>* w) {
+  const std::size_t n = xyz.size() / 3;
+  std::vector<T> out(4 * n);
+  for (std::size_t e = 0; e < n; ++e) {
+    for (int c = 0; c < 3; ++c) out[4 * e + c] = static_cast<T>(xyz[3 * e + c]);
+    out[4 * e + 3] = w ? static_cast<T>((*w)[e]) : T(0);
+  }
+  return out;
+}
+
+template <typename T>
+void unpack4(const std::vector<T>& in, std::vector<double>& xyz) {
+  const std::size_t n = in.size() / 4;
+  xyz.resize(3 * n);
+  for (std::size_t e = 0; e < n; ++e)
+    for (int c = 0; c < 3; ++c) xyz[3 * e + c] = static_cast<double>(in[4 * e + c]);
+}
+
+std::string mib(double bytes) { return std::to_string(static_cast<long long>(bytes / (1 << 20))) + " MiB"; }
+
+}  // namespace
+
+Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const ClContext& cl)
+    : scene_(scene),
+      lattice_(lattice),
+      cl_(cl),
+      precision_(scene.solver.precision),
+      n_(lattice.element_count()),
+      real_size_(scene.solver.precision == Precision::Double ? sizeof(double) : sizeof(float)),
+      inverse_mass_(el.inverse_mass) {
+  require(n_ > 0, "the model has no elements", "model");
+  require(precision_ == Precision::Float || cl.info.fp64,
+          "double precision requested but device '" + cl.info.name + "' has no fp64 support",
+          "solver.precision", "use precision = \"float\" or another device");
+  require(scene.indenters.size() <= 1, "at most one indenter is supported in this version", "indenter");
+  dt_ = choose_time_step(scene, lattice, el);
+  require(dt_.dt_s > 0 && std::isfinite(dt_.dt_s), "time step must be positive and finite", "solver.dt");
+
+  // Padded voxel grid: one empty layer on every side, so neighbour lookups never leave it.
+  const std::array<int, 3> pad = {lattice.dims[0] + 2, lattice.dims[1] + 2, lattice.dims[2] + 2};
+  stride_y_ = pad[0];
+  stride_z_ = pad[0] * pad[1];
+  const std::size_t cells = std::size_t(pad[0]) * pad[1] * pad[2];
+  require(cells < 0x7fffffffu, "the model's bounding box has too many voxels for 32-bit indexing", "model",
+          "downsample or crop the model");
+
+  const std::size_t state_bytes = 4 * real_size_ * n_;
+  device_bytes_ = 4 * state_bytes + n_ * (real_size_ + sizeof(cl_uint)) + cells * sizeof(cl_int);
+  require(double(device_bytes_) < 0.9 * double(cl.info.global_memory_bytes) &&
+              std::max(state_bytes, cells * sizeof(cl_int)) <= cl.info.max_allocation_bytes,
+          "the model needs " + mib(double(device_bytes_)) + " of device memory but '" + cl.info.name +
+              "' has " + mib(double(cl.info.global_memory_bytes)) + " (largest buffer " +
+              mib(double(cl.info.max_allocation_bytes)) + ")",
+          "model", "downsample the model, crop it, or use float precision");
+
+  std::vector<cl_int> grid(cells, -1);
+  std::vector<cl_uint> cell_of(n_);
+  for (std::size_t e = 0; e < n_; ++e) {
+    const auto ijk = lattice.voxel_ijk(e);
+    cell_of[e] = cl_uint((ijk[0] + 1) + stride_y_ * (ijk[1] + 1) + std::size_t(stride_z_) * (ijk[2] + 1));
+    grid[cell_of[e]] = cl_int(e);
+  }
+
+  const auto flags_ro = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
+  grid_ = cl::Buffer(cl.context, flags_ro, cells * sizeof(cl_int), grid.data());
+  cell_ = cl::Buffer(cl.context, flags_ro, n_ * sizeof(cl_uint), cell_of.data());
+  if (precision_ == Precision::Double) {
+    std::vector<double> E(el.youngs_modulus_pa);
+    E_ = cl::Buffer(cl.context, flags_ro, n_ * sizeof(double), E.data());
+  } else {
+    std::vector<float> E(el.youngs_modulus_pa.begin(), el.youngs_modulus_pa.end());
+    E_ = cl::Buffer(cl.context, flags_ro, n_ * sizeof(float), E.data());
+  }
+  u_ = make_state_buffer(el.displacement_m, &el.inverse_mass);
+  v_ = make_state_buffer(std::vector<double>(3 * n_, 0.0), nullptr);
+  u_tmp_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
+  v_tmp_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
+
+  const std::size_t wg = kCheckWorkGroup;
+  check_groups_ = (n_ + wg - 1) / wg;
+  global_ = cl::NDRange(check_groups_ * wg);
+  local_ = cl.info.is_gpu ? cl::NDRange(wg) : cl::NullRange;
+  partial_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * kCheckSlots * real_size_);
+  partial_arg_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * sizeof(cl_int));
+
+  // Only the features this scene uses are compiled in.
+  const bool gravity = scene.gravity.active && scene.gravity.acceleration_m_s2.squaredNorm() > 0;
+  std::string options = "-cl-std=CL1.2";
+  options += " -DVB_DOUBLE=" + std::to_string(precision_ == Precision::Double);
+  options += " -DVB_GRAVITY=" + std::to_string(gravity);
+  options += " -DVB_DASHPOT=" + std::to_string(scene.solver.dashpot_ratio > 0);
+  options += " -DVB_GLOBAL_DAMPING=" + std::to_string(scene.solver.damping_per_s > 0);
+  options += " -DVB_INDENTER=" + std::to_string(!scene.indenters.empty());
+  options += " -DVB_CHECK_WG=" + std::to_string(kCheckWorkGroup);
+  program_ = build_program(cl, {"common.cl", "lattice_forces.cl", "integrate.cl", "checks.cl"},
+                           lattice_tables_source(), options);
+
+  const bool heun = scene.solver.integrator == Integrator::Heun;
+  if (heun) {
+    predict_ = cl::Kernel(program_, "heun_predict");
+    correct_ = cl::Kernel(program_, "heun_correct");
+  } else {
+    euler_ = cl::Kernel(program_, "euler_step");
+  }
+  check_ = cl::Kernel(program_, "check_state");
+  for (cl::Kernel* k : {&euler_, &predict_, &correct_}) {
+    if (!(*k)()) continue;
+    set_lattice_args(*k, 4);
+    if (precision_ == Precision::Double) k->setArg(19, dt_.dt_s); else k->setArg(19, float(dt_.dt_s));
+    k->setArg(20, cl_uint(n_));
+  }
+  if (heun) {
+    predict_.setArg(0, u_); predict_.setArg(1, v_); predict_.setArg(2, u_tmp_); predict_.setArg(3, v_tmp_);
+    correct_.setArg(0, u_); correct_.setArg(1, v_); correct_.setArg(2, u_tmp_); correct_.setArg(3, v_tmp_);
+  }
+  set_lattice_args(check_, 2);
+  check_.setArg(17, partial_);
+  check_.setArg(18, partial_arg_);
+  check_.setArg(19, cl_uint(n_));
+}
+
+cl::Buffer Simulator::make_state_buffer(const std::vector<double>& xyz, const std::vector<double>* w) const {
+  const auto flags = CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR;
+  if (precision_ == Precision::Double) {
+    auto data = pack4<double>(xyz, w);
+    return cl::Buffer(cl_.context, flags, data.size() * sizeof(double), data.data());
+  }
+  auto data = pack4<float>(xyz, w);
+  return cl::Buffer(cl_.context, flags, data.size() * sizeof(float), data.data());
+}
+
+namespace {
+template <typename T, typename V4>
+void set_vec(cl::Kernel& k, int index, const Vec3& v) {
+  V4 x{};
+  x.s[0] = T(v[0]); x.s[1] = T(v[1]); x.s[2] = T(v[2]); x.s[3] = T(0);
+  k.setArg(index, x);
+}
+}  // namespace
+
+void Simulator::set_lattice_args(cl::Kernel& k, int a) {
+  const bool dbl = precision_ == Precision::Double;
+  auto real = [&](int i, double x) { dbl ? k.setArg(i, x) : k.setArg(i, float(x)); };
+  auto vec = [&](int i, const Vec3& x) {
+    dbl ? set_vec<double, cl_double4>(k, i, x) : set_vec<float, cl_float4>(k, i, x);
+  };
+  k.setArg(a + 0, E_);
+  k.setArg(a + 1, cell_);
+  k.setArg(a + 2, grid_);
+  k.setArg(a + 3, cl_int(stride_y_));
+  k.setArg(a + 4, cl_int(stride_z_));
+  real(a + 5, lattice_.spacing_m);
+  real(a + 6, scene_.solver.dashpot_ratio);
+  vec(a + 7, scene_.gravity.active ? scene_.gravity.acceleration_m_s2 : Vec3::Zero());
+  real(a + 8, scene_.solver.damping_per_s);
+  vec(a + 9, lattice_.origin_m);
+  set_indenter_args(k, a + 10, 0.0, 0.0);
+}
+
+Vec3 Simulator::indenter_position(double t) const {
+  const IndenterSpec& ind = scene_.indenters.front();
+  return ind.start_m + ind.velocity_m_s * std::min(t, ind.travel_time_s);
+}
+
+void Simulator::set_indenter_args(cl::Kernel& k, int a, double t_force, double t_project) {
+  const bool dbl = precision_ == Precision::Double;
+  auto real = [&](int i, double x) { dbl ? k.setArg(i, x) : k.setArg(i, float(x)); };
+  auto vec = [&](int i, const Vec3& x) {
+    dbl ? set_vec<double, cl_double4>(k, i, x) : set_vec<float, cl_float4>(k, i, x);
+  };
+  if (scene_.indenters.empty()) {
+    for (int i = 0; i < 4; ++i) vec(a + i, Vec3::Zero());
+    real(a + 4, 0.0);
+    return;
+  }
+  const IndenterSpec& ind = scene_.indenters.front();
+  const bool moving = t_project < ind.travel_time_s;
+  vec(a + 0, indenter_position(t_force));
+  vec(a + 1, indenter_position(t_project));
+  vec(a + 2, ind.normal);
+  vec(a + 3, moving ? ind.velocity_m_s : Vec3::Zero());
+  real(a + 4, ind.kind == IndenterSpec::Kind::Plate ? -1.0 : ind.radius_m);
+}
+
+void Simulator::enqueue(cl::Kernel& k) const { cl_.queue.enqueueNDRangeKernel(k, cl::NullRange, global_, local_); }
+
+void Simulator::advance(std::int64_t steps) {
+  const bool indenter = !scene_.indenters.empty();
+  const double dt = dt_.dt_s;
+  for (std::int64_t s = 0; s < steps; ++s, ++steps_) {
+    const double t0 = double(steps_) * dt, t1 = double(steps_ + 1) * dt;
+    if (scene_.solver.integrator == Integrator::Heun) {
+      if (indenter) {
+        set_indenter_args(predict_, 14, t0, t1);
+        set_indenter_args(correct_, 14, t1, t1);
+      }
+      enqueue(predict_);
+      enqueue(correct_);
+    } else {
+      euler_.setArg(0, u_); euler_.setArg(1, v_); euler_.setArg(2, u_tmp_); euler_.setArg(3, v_tmp_);
+      if (indenter) set_indenter_args(euler_, 14, t0, t1);
+      enqueue(euler_);
+      std::swap(u_, u_tmp_);
+      std::swap(v_, v_tmp_);
+    }
+  }
+  cl_.queue.flush();
+}
+
+StateCheck Simulator::check() {
+  check_.setArg(0, u_);
+  check_.setArg(1, v_);
+  set_indenter_args(check_, 12, time_s(), time_s());
+  enqueue(check_);
+  std::vector<double> p(check_groups_ * kCheckSlots);
+  if (precision_ == Precision::Double) {
+    cl_.queue.enqueueReadBuffer(partial_, CL_TRUE, 0, p.size() * sizeof(double), p.data());
+  } else {
+    std::vector<float> pf(p.size());
+    cl_.queue.enqueueReadBuffer(partial_, CL_TRUE, 0, pf.size() * sizeof(float), pf.data());
+    std::copy(pf.begin(), pf.end(), p.begin());
+  }
+  std::vector<cl_int> arg(check_groups_);
+  cl_.queue.enqueueReadBuffer(partial_arg_, CL_TRUE, 0, arg.size() * sizeof(cl_int), arg.data());
+
+  StateCheck c;
+  for (std::size_t g = 0; g < check_groups_; ++g) {
+    const double* q = &p[g * kCheckSlots];
+    c.max_residual_n = std::max(c.max_residual_n, q[0]);
+    if (q[1] > c.max_speed_m_s || c.fastest_element < 0) {
+      c.max_speed_m_s = q[1];
+      c.fastest_element = arg[g];
+    }
+    c.kinetic_energy_j += q[2];
+    c.max_displacement_m = std::max(c.max_displacement_m, q[3]);
+    c.indenter_force_n += Vec3(q[4], q[5], q[6]);
+    c.contact_elements += std::llround(q[7]);
+    c.nonfinite_elements += std::llround(q[8]);
+  }
+  return c;
+}
+
+void Simulator::download(std::vector<double>& u, std::vector<double>& v) const {
+  if (precision_ == Precision::Double) {
+    std::vector<double> a(4 * n_), b(4 * n_);
+    cl_.queue.enqueueReadBuffer(u_, CL_TRUE, 0, a.size() * sizeof(double), a.data());
+    cl_.queue.enqueueReadBuffer(v_, CL_TRUE, 0, b.size() * sizeof(double), b.data());
+    unpack4(a, u);
+    unpack4(b, v);
+  } else {
+    std::vector<float> a(4 * n_), b(4 * n_);
+    cl_.queue.enqueueReadBuffer(u_, CL_TRUE, 0, a.size() * sizeof(float), a.data());
+    cl_.queue.enqueueReadBuffer(v_, CL_TRUE, 0, b.size() * sizeof(float), b.data());
+    unpack4(a, u);
+    unpack4(b, v);
+  }
+}
+
+void Simulator::upload(const std::vector<double>& u, const std::vector<double>& v) {
+  require(u.size() == 3 * n_ && v.size() == 3 * n_, "state size does not match the model");
+  auto write = [&](const cl::Buffer& buf, const std::vector<double>& xyz, const std::vector<double>* w) {
+    if (precision_ == Precision::Double) {
+      auto d = pack4<double>(xyz, w);
+      cl_.queue.enqueueWriteBuffer(buf, CL_TRUE, 0, d.size() * sizeof(double), d.data());
+    } else {
+      auto d = pack4<float>(xyz, w);
+      cl_.queue.enqueueWriteBuffer(buf, CL_TRUE, 0, d.size() * sizeof(float), d.data());
+    }
+  };
+  write(u_, u, &inverse_mass_);
+  write(v_, v, nullptr);
+}
+
+std::vector<double> Simulator::lattice_forces() const {
+  cl::Kernel k(program_, "lattice_forces");
+  cl::Buffer f(cl_.context, CL_MEM_WRITE_ONLY, 4 * real_size_ * n_);
+  k.setArg(0, u_); k.setArg(1, v_); k.setArg(2, E_); k.setArg(3, cell_); k.setArg(4, grid_);
+  k.setArg(5, cl_int(stride_y_)); k.setArg(6, cl_int(stride_z_));
+  if (precision_ == Precision::Double) {
+    k.setArg(7, lattice_.spacing_m); k.setArg(8, scene_.solver.dashpot_ratio);
+  } else {
+    k.setArg(7, float(lattice_.spacing_m)); k.setArg(8, float(scene_.solver.dashpot_ratio));
+  }
+  k.setArg(9, f);
+  k.setArg(10, cl_uint(n_));
+  enqueue(k);
+  std::vector<double> out;
+  if (precision_ == Precision::Double) {
+    std::vector<double> a(4 * n_);
+    cl_.queue.enqueueReadBuffer(f, CL_TRUE, 0, a.size() * sizeof(double), a.data());
+    unpack4(a, out);
+  } else {
+    std::vector<float> a(4 * n_);
+    cl_.queue.enqueueReadBuffer(f, CL_TRUE, 0, a.size() * sizeof(float), a.data());
+    unpack4(a, out);
+  }
+  return out;
+}
+
+}  // namespace vb

@@ -1,0 +1,80 @@
+#pragma once
+/// The OpenCL simulator: device buffers for one model, kernels built with only the features the
+/// scene uses, and time stepping without host synchronisation between checks.
+#include <CL/opencl.hpp>
+#include <cstdint>
+#include <vector>
+
+#include "engine/lattice/lattice.hpp"
+#include "engine/scene/scene.hpp"
+#include "engine/sim/element_setup.hpp"
+#include "engine/sim/opencl_runtime.hpp"
+#include "engine/sim/time_step.hpp"
+
+namespace vb {
+
+/// Device-side reductions over the current state (see kernels/checks.cl).
+struct StateCheck {
+  double max_residual_n = 0;      ///< largest net static force on a free element (N)
+  double max_speed_m_s = 0;       ///< +inf when some value is not finite
+  double kinetic_energy_j = 0;
+  double max_displacement_m = 0;
+  Vec3 indenter_force_n = Vec3::Zero();  ///< force the tissue exerts on the indenter (N)
+  std::int64_t contact_elements = 0;
+  std::int64_t nonfinite_elements = 0;
+  std::int64_t fastest_element = -1;  ///< element with the largest speed (or first non-finite)
+};
+
+class Simulator {
+ public:
+  /// Uploads the model. Throws vb::Error for double precision on a device without fp64, a model
+  /// too large for the device's memory, or more than one indenter.
+  Simulator(const Scene& scene, const Lattice& lattice, const ElementArrays& elements, const ClContext& cl);
+
+  /// Enqueues `steps` time steps; returns without waiting for the device.
+  void advance(std::int64_t steps);
+  /// Runs the reduction kernel on the current state and waits for it.
+  StateCheck check();
+
+  /// Current state as n×3 doubles.
+  void download(std::vector<double>& u_m, std::vector<double>& v_m_s) const;
+  void upload(const std::vector<double>& u_m, const std::vector<double>& v_m_s);
+  /// Lattice spring + dashpot forces at the current state (n×3, N); for tests.
+  std::vector<double> lattice_forces() const;
+
+  double dt_s() const { return dt_.dt_s; }
+  const TimeStepChoice& time_step() const { return dt_; }
+  double time_s() const { return double(steps_) * dt_.dt_s; }
+  std::int64_t steps() const { return steps_; }
+  std::size_t device_bytes() const { return device_bytes_; }
+  Precision precision() const { return precision_; }
+  /// indenter position at simulated time t (m); scene must have an indenter
+  Vec3 indenter_position(double t_s) const;
+  const ClContext& context() const { return cl_; }
+
+ private:
+  void set_indenter_args(cl::Kernel& k, int first_arg, double t_force, double t_project);
+  void set_lattice_args(cl::Kernel& k, int first_arg);
+  void enqueue(cl::Kernel& k) const;
+  cl::Buffer make_state_buffer(const std::vector<double>& xyz, const std::vector<double>* w) const;
+
+  const Scene& scene_;
+  const Lattice& lattice_;
+  const ClContext& cl_;
+  Precision precision_;
+  std::size_t n_;
+  TimeStepChoice dt_;
+  std::int64_t steps_ = 0;
+  std::size_t device_bytes_ = 0;
+  std::size_t real_size_;
+  std::vector<double> inverse_mass_;
+  int stride_y_ = 0, stride_z_ = 0;
+  cl::NDRange global_, local_;
+  std::size_t check_groups_ = 0;
+
+  cl::Buffer u_, v_, u_tmp_, v_tmp_, E_, cell_, grid_, partial_, partial_arg_;
+  cl::Program program_;
+  cl::Kernel euler_, predict_, correct_, check_;
+};
+
+}  // namespace vb

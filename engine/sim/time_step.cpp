@@ -1,0 +1,101 @@
+#include "engine/sim/time_step.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+
+#include "engine/error.hpp"
+#include "engine/sim/host_reference.hpp"
+
+namespace vb {
+
+StabilityBounds stability_bounds(const Lattice& lattice, const ElementArrays& el, double dashpot_ratio,
+                                 double global_damping) {
+  const auto& offsets = neighbour_offsets();
+  StabilityBounds b;
+  double omega_sq = 0, c_max = 0;
+  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+    if (el.inverse_mass[e] == 0) continue;
+    const auto k = connection_stiffness(lattice, el.youngs_modulus_pa, e);
+    const auto nb = lattice.neighbours(e);
+    for (int a = 0; a < 3; ++a) {
+      double k_row = 0, c_row = 0;
+      for (int d = 0; d < 26; ++d) {
+        if (k[d] == 0) continue;
+        const Vec3 n = Vec3(offsets[d][0], offsets[d][1], offsets[d][2]).normalized();
+        const double w = std::abs(n[a]) * n.cwiseAbs().sum();  // Σ_b |n_a n_b|
+        const double reduced_mass = 1.0 / (el.inverse_mass[e] + el.inverse_mass[nb[d]]);
+        k_row += 2 * k[d] * w;
+        c_row += 2 * (2 * dashpot_ratio * std::sqrt(k[d] * reduced_mass)) * w;
+      }
+      omega_sq = std::max(omega_sq, k_row * el.inverse_mass[e]);
+      c_max = std::max(c_max, c_row * el.inverse_mass[e]);
+    }
+  }
+  b.omega_max = std::sqrt(omega_sq);
+  b.damping_max = c_max + global_damping;
+  return b;
+}
+
+double amplification(Integrator integrator, double w, double c, double dt) {
+  // One step maps (x, v) → A (x, v); A's eigenvalues from its trace and determinant.
+  double a11, a12, a21, a22;
+  if (integrator == Integrator::SymplecticEuler) {
+    a21 = -dt * w * w;
+    a22 = 1 - c * dt;
+    a11 = 1 + dt * a21;
+    a12 = dt * a22;
+  } else {  // Heun = RK2 on J = [[0, 1], [−ω², −c]]: A = I + dt·J + dt²·J²/2
+    const double w2 = w * w;
+    a11 = 1 - 0.5 * dt * dt * w2;
+    a12 = dt - 0.5 * dt * dt * c;
+    a21 = -dt * w2 + 0.5 * dt * dt * c * w2;
+    a22 = 1 - dt * c + 0.5 * dt * dt * (c * c - w2);
+  }
+  const double tr = a11 + a22, det = a11 * a22 - a12 * a21;
+  const std::complex<double> root = std::sqrt(std::complex<double>(tr * tr / 4 - det, 0));
+  return std::max(std::abs(tr / 2 + root), std::abs(tr / 2 - root));
+}
+
+double stable_time_step(Integrator integrator, const StabilityBounds& b, double global_damping) {
+  if (b.omega_max <= 0) return INFINITY;
+  const double beta = (b.damping_max - global_damping) / (b.omega_max * b.omega_max);
+  auto stable = [&](double dt) {
+    for (int i = 0; i <= 400; ++i) {
+      // log-spaced over 6 decades below ω_max, then linear up to it
+      const double s = i <= 200 ? std::pow(10.0, -6.0 + 6.0 * i / 200.0) : (i - 200) / 200.0;
+      const double w = b.omega_max * s;
+      if (amplification(integrator, w, global_damping + beta * w * w, dt) > 1 + 1e-12) return false;
+    }
+    return true;
+  };
+  double lo = 0, hi = 4.0 / b.omega_max;
+  if (stable(hi)) return hi;
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (stable(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+TimeStepChoice choose_time_step(const Scene& scene, const Lattice& lattice, const ElementArrays& el) {
+  TimeStepChoice choice;
+  const SolverSpec& s = scene.solver;
+  choice.bounds = stability_bounds(lattice, el, s.dashpot_ratio, s.damping_per_s);
+  choice.stable_limit_s = stable_time_step(s.integrator, choice.bounds, s.damping_per_s);
+  if (s.dt_s) {
+    choice.dt_s = *s.dt_s;
+    choice.automatic = false;
+    return choice;
+  }
+  // Below 5% of the undamped limit the scheme is only stable through round-off: refuse.
+  require(choice.stable_limit_s > 0.05 * (2.0 / choice.bounds.omega_max),
+          "no stable automatic time step: Heun needs damping to be stable", "solver.dt",
+          "set solver.dashpot_ratio or solver.damping > 0, use integrator = \"symplectic_euler\", or give dt");
+  require(std::isfinite(choice.stable_limit_s), "no elastic connection limits the time step", "solver.dt",
+          "give dt explicitly");
+  choice.dt_s = s.dt_safety * choice.stable_limit_s;
+  return choice;
+}
+
+}  // namespace vb

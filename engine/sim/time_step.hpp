@@ -1,0 +1,38 @@
+#pragma once
+/// Stable explicit time step: bounds on the stiffest mode and damping, and the largest step
+/// for which the integrator's amplification stays ≤ 1 on every mode up to that bound.
+#include "engine/lattice/lattice.hpp"
+#include "engine/scene/scene.hpp"
+#include "engine/sim/element_setup.hpp"
+
+namespace vb {
+
+struct StabilityBounds {
+  double omega_max = 0;    ///< upper bound on the highest angular frequency (rad/s), Gershgorin
+  double damping_max = 0;  ///< upper bound on the highest modal damping rate c (1/s), incl. global
+};
+
+/// Gershgorin bounds of M⁻¹K and M⁻¹C (+ global damping) over the free elements.
+StabilityBounds stability_bounds(const Lattice& lattice, const ElementArrays& elements,
+                                 double dashpot_ratio, double global_damping_per_s);
+
+/// Largest dt for which the integrator is stable on ẍ = −ω²x − c(ω)ẋ for all ω ≤ ω_max, with
+/// c(ω) = γ + (c_max − γ)(ω/ω_max)² (dashpots are stiffness-proportional, global damping not).
+/// Returns 0 when no positive step is stable (Heun without any damping).
+double stable_time_step(Integrator integrator, const StabilityBounds& bounds, double global_damping_per_s);
+
+/// Spectral radius of one step of the integrator on the scalar mode (ω, c) with step dt.
+double amplification(Integrator integrator, double omega, double c, double dt);
+
+struct TimeStepChoice {
+  double dt_s = 0;
+  bool automatic = true;
+  double stable_limit_s = 0;  ///< the bound's stable step (s)
+  StabilityBounds bounds;
+};
+
+/// dt from the scene: "auto" → dt_safety × stable limit; an explicit dt is used as given.
+/// Throws vb::Error when "auto" finds no stable step.
+TimeStepChoice choose_time_step(const Scene& scene, const Lattice& lattice, const ElementArrays& elements);
+
+}  // namespace vb

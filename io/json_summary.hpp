@@ -1,0 +1,17 @@
+#pragma once
+/// OUT/summary.json: the run's key numbers for scripts and checks (layout in docs/OUTPUTS.md).
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "engine/scene/scene.hpp"
+#include "engine/sim/run_result.hpp"
+
+namespace vb {
+
+/// Every field name carries its unit; non-finite numbers become null (JSON has no NaN).
+nlohmann::json summary_to_json(const RunSummary& summary, const Scene& scene);
+
+/// Writes summary_to_json() to `path` atomically (temporary file + rename); throws vb::Error.
+void write_summary_json(const std::string& path, const RunSummary& summary, const Scene& scene);
+
+}  // namespace vb

@@ -1,0 +1,651 @@
+#include "io/scene_file.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "engine/error.hpp"
+#include "engine/loads/posture.hpp"
+
+namespace vb {
+namespace {
+
+using Keys = std::vector<std::string_view>;
+
+/// A key reserved for a later version: rejected with "not supported yet" rather than "unknown",
+/// so users of the documented design learn it exists.
+struct LaterKey {
+  std::string_view key;
+  std::string_view hint;
+};
+
+constexpr std::string_view kLaterVersion = "it comes in a later version";
+
+/// A name accepted for a string-valued key, the value it maps to, and (for `kind` keys) the keys
+/// a table of that kind may hold.
+template <class E>
+struct Named {
+  std::string_view name;
+  E value;
+  Keys keys;  ///< empty for plain choices
+};
+
+template <class E>
+using NameTable = std::vector<Named<E>>;
+
+// ---- words and locations --------------------------------------------------------------------
+
+bool contains(const Keys& words, std::string_view word) {
+  return std::find(words.begin(), words.end(), word) != words.end();
+}
+
+std::string joined(const Keys& words) {
+  std::string s;
+  for (std::string_view w : words) s += (s.empty() ? "" : ", ") + std::string(w);
+  return s;
+}
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1] ? 1 : 0)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+/// "did you mean 'x'?" for the closest candidate within edit distance 2, else empty.
+std::string did_you_mean(std::string_view word, const Keys& candidates) {
+  std::string_view best;
+  std::size_t best_distance = 3;
+  for (std::string_view c : candidates) {
+    const std::size_t d = edit_distance(word, c);
+    if (d < best_distance) best = c, best_distance = d;
+  }
+  return best.empty() ? std::string() : "did you mean '" + std::string(best) + "'?";
+}
+
+/// Hint for a value outside a fixed set: a close match if there is one, and the whole set.
+std::string choice_hint(std::string_view word, const Keys& accepted) {
+  const std::string guess = did_you_mean(word, accepted);
+  return (guess.empty() ? "" : guess + " ") + "accepted: " + joined(accepted);
+}
+
+std::string format_number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+/// "scene.toml:12 key 'materials.adipose.E'" (the line left out when unknown).
+std::string where_string(const std::string& source, int line, const std::string& key_path) {
+  return source + (line > 0 ? ":" + std::to_string(line) : "") + " key '" + key_path + "'";
+}
+
+int line_of(const toml::source_region& region) { return static_cast<int>(region.begin.line); }
+
+std::string describe(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a float";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array of " + std::to_string(node.as_array()->size()) + " items";
+    default:
+      return "a date/time";
+  }
+}
+
+std::optional<double> as_double(const toml::node& node) {
+  if (const auto* i = node.as_integer()) return static_cast<double>(i->get());
+  if (const auto* f = node.as_floating_point()) return f->get();
+  return std::nullopt;
+}
+
+const toml::table& empty_table() {
+  static const toml::table table;
+  return table;
+}
+
+// ---- typed, located access to one TOML table -------------------------------------------------
+
+/// One table of the scene with its dotted path: typed getters that throw located vb::Errors.
+/// Getters return std::nullopt for an absent key, so defaults stay in the Scene structs.
+class Section {
+ public:
+  Section(const toml::table& table, std::string path, const std::string& source)
+      : table_(&table), path_(std::move(path)), source_(&source) {}
+
+  int line() const { return line_of(table_->source()); }
+
+  std::string key_path(std::string_view key) const {
+    return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+  }
+
+  /// The key's line, else (absent key) the table's.
+  int line_of_key(std::string_view key) const {
+    const auto it = table_->find(key);
+    if (it == table_->end()) return line();
+    if (const int l = line_of(it->second.source())) return l;
+    return line_of(it->first.source());
+  }
+
+  std::string where(std::string_view key) const {
+    return where_string(*source_, line_of_key(key), key_path(key));
+  }
+
+  [[noreturn]] void fail(std::string_view key, const std::string& what,
+                         const std::string& hint = {}) const {
+    throw Error(what, where(key), hint);
+  }
+
+  const toml::node* find(std::string_view key) const { return table_->get(key); }
+
+  /// Every key must be in `allowed`; `later` keys get "not supported yet"; `context` follows
+  /// "unknown key" in the message (e.g. " for kind 'box'").
+  void check_keys(const Keys& allowed, const std::vector<LaterKey>& later = {},
+                  std::string_view context = {}) const {
+    const std::optional<std::string_view> key = first_key_not_in(allowed);
+    if (!key) return;
+    for (const LaterKey& l : later) {
+      if (l.key == *key) fail(*key, key_path(*key) + " is not supported yet", std::string(l.hint));
+    }
+    std::string hint = did_you_mean(*key, allowed);
+    if (hint.empty()) hint = "allowed keys here: " + joined(allowed);
+    fail(*key, "unknown key" + std::string(context), hint);
+  }
+
+  std::optional<Section> table(std::string_view key) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    if (!node->is_table()) wrong_type(key, *node, "a table");
+    return Section(*node->as_table(), key_path(key), *source_);
+  }
+
+  /// An absent table reads as an empty one, so every key takes its default.
+  Section table_or_empty(std::string_view key) const {
+    return table(key).value_or(Section(empty_table(), key_path(key), *source_));
+  }
+
+  /// `[[key]]` array of tables, each named "path.key[i]"; absent → none.
+  std::vector<Section> tables(std::string_view key) const {
+    const toml::node* node = find(key);
+    if (!node) return {};
+    const toml::array* array = node->as_array();
+    const auto is_table = [](const toml::node& n) { return n.is_table(); };
+    if (!array || !std::all_of(array->begin(), array->end(), is_table)) {
+      wrong_type(key, *node, "an array of tables [[" + key_path(key) + "]]");
+    }
+    std::vector<Section> sections;
+    for (std::size_t i = 0; i < array->size(); ++i) {
+      sections.emplace_back(*array->get(i)->as_table(),
+                            key_path(key) + "[" + std::to_string(i) + "]", *source_);
+    }
+    return sections;
+  }
+
+  /// Named sub-tables `[path.NAME]`, in file order.
+  std::vector<std::pair<std::string, Section>> named_tables() const {
+    std::vector<std::pair<std::string, Section>> sections;
+    for (const auto& [key, node] : *table_) {
+      if (!node.is_table()) wrong_type(key.str(), node, "a table [" + path_ + ".NAME]");
+      sections.emplace_back(std::string(key.str()),
+                            Section(*node.as_table(), key_path(key.str()), *source_));
+    }
+    std::stable_sort(sections.begin(), sections.end(), [](const auto& a, const auto& b) {
+      return a.second.line() < b.second.line();
+    });
+    return sections;
+  }
+
+  std::optional<std::string> text(std::string_view key) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    if (!node->is_string()) wrong_type(key, *node, "a string");
+    return node->as_string()->get();
+  }
+
+  /// A finite number; integers are accepted.
+  std::optional<double> number(std::string_view key) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    const std::optional<double> v = as_double(*node);
+    if (!v) wrong_type(key, *node, "a number");
+    if (!std::isfinite(*v)) fail(key, "must be finite, got " + format_number(*v));
+    return v;
+  }
+
+  std::optional<double> positive(std::string_view key) const { return bounded(key, true); }
+  std::optional<double> non_negative(std::string_view key) const { return bounded(key, false); }
+
+  /// An integer in [min, largest Int]; floats are refused (counts are never fractional).
+  template <class Int>
+  std::optional<Int> integer(std::string_view key, Int min) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    if (!node->is_integer()) wrong_type(key, *node, "an integer");
+    const std::int64_t v = node->as_integer()->get();
+    if (v < min || v > std::numeric_limits<Int>::max()) {
+      fail(key, "must be an integer ≥ " + std::to_string(min) + ", got " + std::to_string(v));
+    }
+    return static_cast<Int>(v);
+  }
+
+  std::optional<Vec3> vec3(std::string_view key) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    const toml::array* array = node->as_array();
+    if (!array || array->size() != 3) wrong_type(key, *node, "an array of 3 numbers");
+    Vec3 v;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const std::optional<double> x = as_double(*array->get(i));
+      if (!x) {
+        fail(key, "expected an array of 3 numbers, element " + std::to_string(i) + " is " +
+                      describe(*array->get(i)));
+      }
+      if (!std::isfinite(*x)) fail(key, "components must be finite");
+      v[static_cast<Eigen::Index>(i)] = *x;
+    }
+    return v;
+  }
+
+  std::optional<Vec3> positive_vec3(std::string_view key) const {
+    const std::optional<Vec3> v = vec3(key);
+    if (v && !(v->array() > 0).all()) fail(key, "every component must be > 0");
+    return v;
+  }
+
+  /// A nonzero vector, normalised on reading.
+  std::optional<Vec3> direction(std::string_view key) const {
+    const std::optional<Vec3> v = vec3(key);
+    if (!v) return std::nullopt;
+    if (v->norm() == 0) fail(key, "must be a nonzero vector");
+    return v->normalized();
+  }
+
+  /// A string that must be one of `names`; nullptr when absent.
+  template <class E>
+  const Named<E>* named(std::string_view key, const NameTable<E>& names) const {
+    const std::optional<std::string> value = text(key);
+    if (!value) return nullptr;
+    for (const Named<E>& n : names) {
+      if (n.name == *value) return &n;
+    }
+    fail(key, "unknown value '" + *value + "'", choice_hint(*value, names_of(names)));
+  }
+
+  /// The required `kind` key; checks the table's keys against that kind's list.
+  template <class E>
+  const Named<E>& kind(const NameTable<E>& kinds) const {
+    const Named<E>* k = named("kind", kinds);
+    if (!k) fail("kind", "missing required key", "accepted: " + joined(names_of(kinds)));
+    const std::string kind_name(k->name);
+    // A key of another kind (radius on a box) is a mix-up, not a typo: say so.
+    const std::optional<std::string_view> extra = first_key_not_in(k->keys);
+    const auto has_extra = [&](const Named<E>& other) { return contains(other.keys, *extra); };
+    if (extra && std::any_of(kinds.begin(), kinds.end(), has_extra)) {
+      fail(*extra, "'" + std::string(*extra) + "' does not apply to kind '" + kind_name + "'",
+           "keys for kind '" + kind_name + "': " + joined(k->keys));
+    }
+    check_keys(k->keys, {}, " for kind '" + kind_name + "'");
+    return *k;
+  }
+
+  template <class T>
+  T required(std::string_view key, std::optional<T> value) const {
+    if (!value) fail(key, "missing required key");
+    return *std::move(value);
+  }
+
+ private:
+  /// The earliest (in file order) key of this table not in `allowed`.
+  std::optional<std::string_view> first_key_not_in(const Keys& allowed) const {
+    std::optional<std::string_view> first;
+    for (const auto& entry : *table_) {
+      const std::string_view key = entry.first.str();
+      if (contains(allowed, key)) continue;
+      if (!first || line_of_key(key) < line_of_key(*first)) first = key;
+    }
+    return first;
+  }
+
+  [[noreturn]] void wrong_type(std::string_view key, const toml::node& node,
+                               const std::string& expected) const {
+    fail(key, "expected " + expected + ", got " + describe(node));
+  }
+
+  std::optional<double> bounded(std::string_view key, bool strictly_positive) const {
+    const std::optional<double> v = number(key);
+    if (v && (strictly_positive ? !(*v > 0) : !(*v >= 0))) {
+      fail(key, std::string("must be ") + (strictly_positive ? "> 0" : "≥ 0") + ", got " +
+                    format_number(*v));
+    }
+    return v;
+  }
+
+  template <class E>
+  static Keys names_of(const NameTable<E>& names) {
+    Keys keys;
+    for (const Named<E>& n : names) keys.push_back(n.name);
+    return keys;
+  }
+
+  const toml::table* table_;
+  std::string path_;
+  const std::string* source_;
+};
+
+// ---- the scene's sections -------------------------------------------------------------------
+
+void read_box(const Section& s, Vec3& min, Vec3& max) {
+  min = s.required("min", s.vec3("min"));
+  max = s.required("max", s.vec3("max"));
+  if (!(max.array() > min.array()).all()) s.fail("max", "must exceed 'min' in every component");
+}
+
+const NameTable<ShapeSpec::Kind> kShapeKinds = {
+    {"box", ShapeSpec::Kind::Box, {"kind", "label", "min", "max"}},
+    {"sphere", ShapeSpec::Kind::Sphere, {"kind", "label", "center", "radius"}},
+    {"ellipsoid", ShapeSpec::Kind::Ellipsoid, {"kind", "label", "center", "radii"}},
+    {"half_ellipsoid",
+     ShapeSpec::Kind::HalfEllipsoid,
+     {"kind", "label", "center", "radii", "axis"}},
+    {"hemisphere", ShapeSpec::Kind::Hemisphere, {"kind", "label", "center", "radius", "axis"}},
+};
+
+ShapeSpec read_shape(const Section& s) {
+  ShapeSpec shape;
+  const Named<ShapeSpec::Kind>& kind = s.kind(kShapeKinds);
+  shape.kind = kind.value;
+  shape.line = s.line();
+  shape.label = s.required("label", s.text("label"));
+  // Kinds share keys (centre, radius, ...); the kind's key list says which it has.
+  const auto has = [&](std::string_view key) { return contains(kind.keys, key); };
+  if (has("min")) read_box(s, shape.min_m, shape.max_m);
+  if (has("center")) shape.center_m = s.required("center", s.vec3("center"));
+  if (has("radius")) shape.radius_m = s.required("radius", s.positive("radius"));
+  if (has("radii")) shape.radii_m = s.required("radii", s.positive_vec3("radii"));
+  if (has("axis")) shape.axis = s.direction("axis").value_or(shape.axis);
+  return shape;
+}
+
+ModelSpec read_model(const Section& s) {
+  constexpr std::string_view kShapesOnly = "analytic shapes only in this version";
+  s.check_keys({"spacing", "downsample", "shape"},
+               {{"image", kShapesOnly}, {"labels", kShapesOnly}, {"hu_thresholds", kShapesOnly}});
+  ModelSpec model;
+  model.downsample = s.integer<int>("downsample", 1).value_or(model.downsample);
+  for (const Section& shape : s.tables("shape")) model.shapes.push_back(read_shape(shape));
+  if (model.shapes.empty()) {
+    s.fail("shape", "the model has no shapes", "add [[model.shape]] tables; see docs/SCENE.md");
+  }
+  model.spacing_m = s.required("spacing", s.positive("spacing"));
+  return model;
+}
+
+void check_law(const Section& s, const std::string& law) {
+  const Keys available = {"linear"};
+  const Keys later = {"biphasic_spring", "neo-hookean", "neo_hookean", "mooney-rivlin", "ogden"};
+  if (contains(available, law)) return;
+  if (contains(later, law)) {
+    s.fail("law", "law '" + law + "' is not available in this version", "use law = \"linear\"");
+  }
+  s.fail("law", "unknown law '" + law + "'", choice_hint(law, available));
+}
+
+MaterialSpec read_material(const std::string& name, const Section& s) {
+  s.check_keys({"law", "E", "density", "nu"});
+  MaterialSpec m;
+  m.name = name;
+  m.line = s.line();
+  m.law = s.text("law").value_or(m.law);
+  check_law(s, m.law);
+  if (m.law == "linear" && s.find("nu")) {
+    s.fail(
+        "nu",
+        "linear lattice springs have Poisson ratio 0.25 fixed; 'nu' applies to hyperelastic laws",
+        "remove 'nu'");
+  }
+  m.youngs_modulus_pa = s.required("E", s.positive("E"));
+  m.density_kg_m3 = s.positive("density").value_or(m.density_kg_m3);
+  return m;
+}
+
+std::map<std::string, MaterialSpec> read_materials(const Section& s) {
+  std::map<std::string, MaterialSpec> materials;
+  for (const auto& [name, table] : s.named_tables()) materials[name] = read_material(name, table);
+  return materials;
+}
+
+const NameTable<Integrator> kIntegrators = {
+    {"heun", Integrator::Heun, {}},
+    {"symplectic_euler", Integrator::SymplecticEuler, {}},
+    {"euler", Integrator::SymplecticEuler, {}},
+};
+const NameTable<Precision> kPrecisions = {{"float", Precision::Float, {}},
+                                          {"double", Precision::Double, {}}};
+
+/// `dt` is "auto" (empty) or a positive step in seconds.
+std::optional<double> read_dt(const Section& s) {
+  const toml::node* node = s.find("dt");
+  if (node && node->is_string()) {
+    if (node->as_string()->get() != "auto") s.fail("dt", "expected \"auto\" or a number > 0 (s)");
+    return std::nullopt;
+  }
+  return s.positive("dt");
+}
+
+SolverSpec read_solver(const Section& s) {
+  s.check_keys(
+      {"integrator", "dt", "dt_safety", "precision", "damping", "dashpot_ratio", "check_every"});
+  SolverSpec v;
+  if (const auto* n = s.named("integrator", kIntegrators)) v.integrator = n->value;
+  v.dt_s = read_dt(s);
+  v.dt_safety = s.positive("dt_safety").value_or(v.dt_safety);
+  if (v.dt_safety > 1) s.fail("dt_safety", "must be in (0, 1], got " + format_number(v.dt_safety));
+  if (const auto* n = s.named("precision", kPrecisions)) v.precision = n->value;
+  v.damping_per_s = s.non_negative("damping").value_or(v.damping_per_s);
+  v.dashpot_ratio = s.non_negative("dashpot_ratio").value_or(v.dashpot_ratio);
+  v.check_every = s.integer<int>("check_every", 1).value_or(v.check_every);
+  return v;
+}
+
+GravitySpec read_gravity(const Section& s) {
+  s.check_keys({"vector", "posture", "magnitude"});
+  const std::optional<Vec3> vector = s.vec3("vector");
+  const std::optional<std::string> posture = s.text("posture");
+  if (vector && posture) {
+    s.fail("posture", "give either 'gravity.vector' or 'gravity.posture', not both");
+  }
+  if (!vector && !posture) s.fail("vector", "[gravity] needs 'vector' or 'posture'");
+  GravitySpec g;
+  g.active = true;
+  if (vector) {
+    if (s.find("magnitude")) s.fail("magnitude", "'magnitude' applies only with 'posture'");
+    g.acceleration_m_s2 = *vector;
+    return g;
+  }
+  const double magnitude = s.positive("magnitude").value_or(kStandardGravity_m_s2);
+  try {
+    g.acceleration_m_s2 = gravity_for_posture(*posture) * (magnitude / kStandardGravity_m_s2);
+  } catch (const Error& e) {
+    s.fail("posture", e.problem(), e.hint());  // same error, now with its file location
+  }
+  g.posture = *posture;
+  return g;
+}
+
+const NameTable<AnchorSpec::Kind> kAnchorKinds = {
+    {"sphere", AnchorSpec::Kind::Sphere, {"kind", "center", "radius", "rpy_deg"}},
+    {"halfspace", AnchorSpec::Kind::HalfSpace, {"kind", "point", "normal"}},
+    {"box", AnchorSpec::Kind::Box, {"kind", "min", "max"}},
+};
+
+AnchorSpec read_anchor(const std::string& name, const Section& s) {
+  AnchorSpec a;
+  a.name = name;
+  a.line = s.line();
+  a.kind = s.kind(kAnchorKinds).value;
+  switch (a.kind) {
+    case AnchorSpec::Kind::Sphere:
+      a.center_m = s.required("center", s.vec3("center"));
+      a.radius_m = s.required("radius", s.positive("radius"));
+      a.rpy_deg = s.vec3("rpy_deg").value_or(a.rpy_deg);
+      break;
+    case AnchorSpec::Kind::HalfSpace:
+      a.point_m = s.required("point", s.vec3("point"));
+      a.normal = s.required("normal", s.direction("normal"));
+      break;
+    case AnchorSpec::Kind::Box:
+      read_box(s, a.min_m, a.max_m);
+      break;
+  }
+  return a;
+}
+
+const NameTable<IndenterSpec::Kind> kIndenterKinds = {
+    {"sphere", IndenterSpec::Kind::Sphere, {"kind", "radius", "start", "velocity", "travel_time"}},
+    {"plate", IndenterSpec::Kind::Plate, {"kind", "start", "normal", "velocity", "travel_time"}},
+};
+
+IndenterSpec read_indenter(const Section& s) {
+  IndenterSpec i;
+  i.line = s.line();
+  i.kind = s.kind(kIndenterKinds).value;
+  if (i.kind == IndenterSpec::Kind::Sphere) i.radius_m = s.required("radius", s.positive("radius"));
+  if (i.kind == IndenterSpec::Kind::Plate) i.normal = s.required("normal", s.direction("normal"));
+  i.start_m = s.required("start", s.vec3("start"));
+  i.velocity_m_s = s.vec3("velocity").value_or(i.velocity_m_s);
+  i.travel_time_s = s.positive("travel_time").value_or(i.travel_time_s);
+  return i;
+}
+
+std::vector<TrackSpec> read_tracks(const std::vector<Section>& sections) {
+  std::vector<TrackSpec> tracks;
+  for (const Section& s : sections) {
+    s.check_keys({"name", "point"});
+    TrackSpec t;
+    t.name = s.required("name", s.text("name"));
+    t.point_m = s.required("point", s.vec3("point"));
+    t.line = s.line();
+    const auto same = std::find_if(tracks.begin(), tracks.end(),
+                                   [&](const TrackSpec& other) { return other.name == t.name; });
+    if (same != tracks.end()) {
+      s.fail("name", "duplicate track name '" + t.name + "'",
+             "first used at line " + std::to_string(same->line));
+    }
+    tracks.push_back(t);
+  }
+  return tracks;
+}
+
+StopSpec read_stop(const Section& s) {
+  s.check_keys({"equilibrium", "max_steps", "time"});
+  StopSpec stop;
+  stop.equilibrium = s.non_negative("equilibrium").value_or(stop.equilibrium);
+  stop.max_steps = s.integer<std::int64_t>("max_steps", 1).value_or(stop.max_steps);
+  stop.max_time_s = s.positive("time").value_or(stop.max_time_s);
+  return stop;
+}
+
+OutputSpec read_output(const Section& s) {
+  s.check_keys({"frames_every"},
+               {{"dvf", kLaterVersion}, {"warped_ct", kLaterVersion}, {"surfaces", kLaterVersion}});
+  OutputSpec out;
+  out.frames_every = s.integer<int>("frames_every", 0).value_or(out.frames_every);
+  return out;
+}
+
+/// Runs after everything is read: shapes may come before the materials they name.
+void check_labels(const Scene& scene, const std::string& source) {
+  Keys names;
+  for (const auto& entry : scene.materials) names.push_back(entry.first);
+  for (std::size_t i = 0; i < scene.model.shapes.size(); ++i) {
+    const ShapeSpec& shape = scene.model.shapes[i];
+    if (scene.materials.count(shape.label)) continue;
+    const std::string guess = did_you_mean(shape.label, names);
+    throw Error("label '" + shape.label + "' names no [materials." + shape.label + "] table",
+                where_string(source, shape.line, "model.shape[" + std::to_string(i) + "].label"),
+                guess.empty() ? "define [materials." + shape.label + "] with 'E'" : guess);
+  }
+}
+
+toml::table parse_toml(const std::string& text, const std::string& source) {
+  try {
+    return toml::parse(std::string_view(text), std::string_view(source));
+  } catch (const toml::parse_error& e) {
+    const toml::source_position& at = e.source().begin;
+    throw Error("TOML syntax error: " + std::string(e.description()),
+                source + ":" + std::to_string(at.line) + ":" + std::to_string(at.column),
+                "fix the TOML syntax; see https://toml.io");
+  }
+}
+
+std::string read_text_file(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw Error("scene file not found (or not a regular file)", path, "check the path");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot open the scene file", path, "check the file's permissions");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw Error("cannot read the scene file", path);
+  return text;
+}
+
+}  // namespace
+
+Scene parse_scene_text(const std::string& text, const std::string& source_name) {
+  const toml::table root = parse_toml(text, source_name);
+  const Section top(root, "", source_name);
+  top.check_keys(
+      {"model", "materials", "solver", "gravity", "anchor", "indenter", "track", "stop", "output"},
+      {{"volume", kLaterVersion}, {"device", kLaterVersion}});
+  Scene scene;
+  scene.model = read_model(top.table_or_empty("model"));
+  scene.materials = read_materials(top.table_or_empty("materials"));
+  scene.solver = read_solver(top.table_or_empty("solver"));
+  if (const auto gravity = top.table("gravity")) scene.gravity = read_gravity(*gravity);
+  for (const auto& [name, s] : top.table_or_empty("anchor").named_tables()) {
+    scene.anchors.push_back(read_anchor(name, s));
+  }
+  for (const Section& s : top.tables("indenter")) scene.indenters.push_back(read_indenter(s));
+  scene.tracks = read_tracks(top.tables("track"));
+  scene.stop = read_stop(top.table_or_empty("stop"));
+  scene.output = read_output(top.table_or_empty("output"));
+  check_labels(scene, source_name);
+  scene.source_text = text;
+  return scene;
+}
+
+Scene parse_scene_file(const std::string& path) {
+  Scene scene = parse_scene_text(read_text_file(path), path);
+  scene.source_path = path;
+  return scene;
+}
+
+}  // namespace vb

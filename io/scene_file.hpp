@@ -1,0 +1,19 @@
+#pragma once
+/// Scene files (TOML, SI units) → vb::Scene. Strict: unknown keys, wrong types and values out of
+/// range are vb::Error naming the file, line and dotted key, so a typo never silently changes
+/// physics. The format is documented in docs/SCENE.md.
+#include <string>
+
+#include "engine/scene/scene.hpp"
+
+namespace vb {
+
+/// Reads and parses the scene file at `path`; Scene::source_path is `path`.
+/// Throws vb::Error when the file cannot be read or the scene is invalid.
+Scene parse_scene_file(const std::string& path);
+
+/// Parses scene text; `source_name` (e.g. the file name) is used in error locations.
+/// Scene::source_text is `text`; Scene::source_path is left empty.
+Scene parse_scene_text(const std::string& text, const std::string& source_name);
+
+}  // namespace vb

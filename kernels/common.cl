@@ -1,0 +1,41 @@
+// Precision and feature switches shared by every kernel. The host passes
+//   -DVB_DOUBLE=0|1   real = float | double
+//   -DVB_GRAVITY=0|1, -DVB_DASHPOT=0|1, -DVB_GLOBAL_DAMPING=0|1, -DVB_INDENTER=0|1
+//                     so only what the scene uses is compiled
+//   -DVB_CHECK_WG=N   work-group size of the reduction kernel
+// and prepends the lattice tables (VB_DIR, VB_DIR_LEN, VB_KAPPA) generated from the host's
+// single definition (engine/sim/kernel_tables.cpp).
+#if VB_DOUBLE
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+typedef double real;
+typedef double4 real4;
+#else
+typedef float real;
+typedef float4 real4;
+#endif
+
+inline real4 xyz0(real4 a) { return (real4)(a.x, a.y, a.z, 0); }
+inline real dot3(real4 a, real4 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+// Rest (voxel-centre) position of the element stored at padded grid cell `cell`.
+// The padded grid has one empty voxel on every side: cell = (i+1) + sy·(j+1) + sz·(k+1).
+inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
+  const int k = (int)(cell / (uint)sz);
+  const int rem = (int)(cell - (uint)(k * sz));
+  const int j = rem / sy;
+  const int i = rem - j * sy;
+  return (real4)(origin.x + h * (i - 1), origin.y + h * (j - 1), origin.z + h * (k - 1), 0);
+}
+
+// An element within this fraction of a spacing of the indenter surface is in contact.
+#define REAL_CONTACT_TOL ((real)1e-3)
+
+// Parameters every stepping kernel takes, in this order (the host sets them in one place).
+#define VB_LATTICE_PARAMS                                                                      \
+  global const real *E, global const uint *cell_of, global const int *grid, int sy, int sz,  \
+      real h, real dashpot_ratio, real4 gravity, real damping, real4 origin
+#define VB_LATTICE_ARGS E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity, damping, origin
+// Indenter: position where forces are evaluated, position for the end-of-stage projection,
+// plate normal, velocity, radius (< 0: plate). Ignored when VB_INDENTER is 0.
+#define VB_INDENTER_PARAMS \
+  real4 ind_force_pos, real4 ind_proj_pos, real4 ind_normal, real4 ind_velocity, real ind_radius

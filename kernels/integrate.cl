@@ -1,0 +1,78 @@
+// Time integrators. One work-item per element; held elements (u.w == 0) never move.
+//   symplectic Euler (main paper eq. 11):  v' = v + dt·a(u, v);  u' = u + dt·v'
+//   Heun (improved Euler, trapezium rule): predictor ũ = u + dt·v, ṽ = v + dt·a(u, v);
+//     corrector u' = u + dt/2·(v + ṽ), v' = v + dt/2·(a(u, v) + a(ũ, ṽ)) = (v + ṽ)/2 + dt/2·a(ũ, ṽ)
+//     (a(u, v) is recovered from ṽ, so no force buffer is stored).
+
+inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                          VB_LATTICE_PARAMS, real4 ind_pos, real4 ind_normal, real ind_radius) {
+  real4 f = static_force(e, ui, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity);
+#if VB_GLOBAL_DAMPING
+  f -= damping * xyz0(vi) / ui.w;
+#endif
+#if VB_INDENTER
+  const real4 x = rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui);
+  contact_constrain(&f, x, ind_pos, ind_normal, ind_radius, h);
+#endif
+  return f * ui.w;
+}
+
+inline void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_of, int sy, int sz,
+                         real4 origin, real h, VB_INDENTER_PARAMS) {
+#if VB_INDENTER
+  contact_project(un, vn, rest_position(cell_of[e], sy, sz, origin, h), ind_proj_pos, ind_normal,
+                  ind_radius, ind_velocity);
+#endif
+}
+
+kernel void euler_step(global const real4* u, global const real4* v, global real4* u_out,
+                       global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
+                       uint n) {
+  const uint e = get_global_id(0);
+  if (e >= n) return;
+  real4 ui = u[e], vi = v[e];
+  if (ui.w != 0) {
+    const real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, ind_force_pos, ind_normal, ind_radius);
+    vi += dt * a;
+    ui += dt * xyz0(vi);
+    finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, ind_force_pos, ind_proj_pos, ind_normal,
+                 ind_velocity, ind_radius);
+  }
+  u_out[e] = ui;
+  v_out[e] = vi;
+}
+
+kernel void heun_predict(global const real4* u, global const real4* v, global real4* u_pred,
+                         global real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
+                         uint n) {
+  const uint e = get_global_id(0);
+  if (e >= n) return;
+  real4 ui = u[e], vi = v[e];
+  if (ui.w != 0) {
+    const real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, ind_force_pos, ind_normal, ind_radius);
+    ui += dt * xyz0(vi);
+    vi += dt * a;
+    finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, ind_force_pos, ind_proj_pos, ind_normal,
+                 ind_velocity, ind_radius);
+  }
+  u_pred[e] = ui;
+  v_pred[e] = vi;
+}
+
+kernel void heun_correct(global real4* u, global real4* v, global const real4* u_pred,
+                         global const real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS,
+                         real dt, uint n) {
+  const uint e = get_global_id(0);
+  if (e >= n) return;
+  real4 ui = u[e];
+  if (ui.w == 0) return;
+  const real4 vi = v[e], up = u_pred[e], vp = v_pred[e];
+  const real4 a = acceleration(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, ind_force_pos, ind_normal,
+                               ind_radius);
+  real4 vn = xyz0((vi + vp) * (real)0.5 + (real)0.5 * dt * a);
+  ui += (real)0.5 * dt * xyz0(vi + vp);
+  finish_stage(e, &ui, &vn, cell_of, sy, sz, origin, h, ind_force_pos, ind_proj_pos, ind_normal,
+               ind_velocity, ind_radius);
+  u[e] = ui;
+  v[e] = vn;
+}

@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# One command from a fresh Debian 12 machine: install dependencies, build, run the whole suite.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${VOXBREAST_BUILD_DIR:-$root/build}
+bash "$root/scripts/setup.sh"
+bash "$root/scripts/build.sh"
+# Tests run on the CPU OpenCL device unless told otherwise (CI has only PoCL).
+export VOXBREAST_DEVICE=${VOXBREAST_DEVICE:-cpu}
+cd "$build"
+ctest --output-on-failure --parallel "$(nproc)" --timeout 1200

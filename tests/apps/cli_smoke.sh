@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# End-to-end checks of the voxbreast command line: the bundled sample runs and writes its
+# outputs; each kind of bad input fails with a one-line error, a non-zero exit, and no result.h5.
+#   VOXBREAST_BIN=build/apps/voxbreast bash tests/apps/cli_smoke.sh .
+set -uo pipefail
+root=${1:?source dir}
+bin=${VOXBREAST_BIN:?path to voxbreast}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+failures=0
+passes=0
+pass() { passes=$((passes + 1)); echo "ok   $1"; }
+fail() { failures=$((failures + 1)); echo "FAIL $1"; }
+
+# --- info
+if "$bin" info >"$work/info.txt" 2>&1 && grep -q "fp64" "$work/info.txt"; then pass "info lists devices"; else fail "info"; cat "$work/info.txt"; fi
+
+# --- the bundled sample
+if "$bin" simulate "$root/data-samples/breast_phantom.toml" --out "$work/sample" --quiet >"$work/sample.txt" 2>&1 \
+   && grep -q "wrote .*summary.json" "$work/sample.txt" && grep -q "wrote .*result.h5" "$work/sample.txt" \
+   && python3 - "$work/sample/summary.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["converged"] is True, s["stop_reason"]
+assert s["elements"] > 5000 and s["connections"] > 10 * s["elements"]
+t = s["tracked"]["tumour_centre"]["displacement_m"]
+assert t[1] < -0.002, t  # prone: the tumour moves anteriorly (−y, away from the chest wall)
+PY
+then pass "sample scene converges, tumour moves anteriorly, outputs written"
+else fail "sample scene"; cat "$work/sample.txt"; fi
+if h5dump -H "$work/sample/result.h5" 2>/dev/null | grep -q '"displacement_m"'; then pass "result.h5 readable"; else fail "result.h5"; fi
+
+# --- bad input: each must fail with one 'voxbreast: error:' line naming the problem, and no result.h5
+scene() {  # base scene: a small block on a held base
+  cat <<TOML
+[model]
+spacing = 0.002
+[[model.shape]]
+kind = "box"
+min = [0.0, 0.0, 0.0]
+max = [0.01, 0.01, 0.01]
+label = "soft"
+[materials.soft]
+E = 3000.0
+[gravity]
+vector = [0.0, 0.0, -9.81]
+[anchor.base]
+kind = "halfspace"
+point = [0.0, 0.0, 0.002]
+normal = [0.0, 0.0, -1.0]
+[stop]
+max_steps = 2000
+TOML
+}
+expect_error() {  # name, expected text, scene text, [extra args]
+  local name=$1 expected=$2 text=$3
+  shift 3
+  local dir="$work/$name"
+  printf '%s\n' "$text" >"$work/$name.toml"
+  "$bin" simulate "$work/$name.toml" --out "$dir" --quiet "$@" >"$work/$name.out" 2>"$work/$name.err"
+  local rc=$?
+  local lines
+  lines=$(wc -l <"$work/$name.err")
+  if [[ $rc -ne 0 && $lines -eq 1 ]] && grep -q "^voxbreast: error:.*$expected" "$work/$name.err" && [[ ! -e "$dir/result.h5" ]]; then
+    pass "$name: $(cat "$work/$name.err")"
+  else
+    fail "$name (rc $rc, $lines lines, expected '$expected')"; cat "$work/$name.err"
+  fi
+}
+
+expect_error typo "materials.soft.Ee" "$(scene | sed 's/^E = 3000.0/Ee = 3000.0/')"
+expect_error negative_modulus "materials.soft.E" "$(scene | sed 's/^E = 3000.0/E = -3000.0/')"
+expect_error zero_spacing "model.spacing" "$(scene | sed 's/^spacing = 0.002/spacing = 0.0/')"
+expect_error anchor_holds_nothing "anchor 'base' holds no element" "$(scene | sed 's/^point = \[0.0, 0.0, 0.002\]/point = [0.0, 0.0, -1.0]/')"
+expect_error no_elements "no elements" "$(scene | sed 's/^max = \[0.01, 0.01, 0.01\]/max = [0.0005, 0.0005, 0.0005]/')"
+expect_error unstable "unstable at step" "$(scene; printf '[solver]\nintegrator = "symplectic_euler"\ndt = 0.01\n')"
+expect_error unwritable_output "cannot write to output folder" "$(scene)" --out /proc/voxbreast-not-writable
+expect_error missing_material "soft" "$(scene | sed 's/^\[materials.soft\]/[materials.other]/')"
+
+echo "$passes passed, $failures failed"
+[[ $failures -eq 0 ]]

@@ -1,0 +1,137 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "engine/error.hpp"
+#include "engine/lattice/lattice.hpp"
+#include "engine/lattice/voxelise.hpp"
+#include "tests/engine/sim/sim_fixtures.hpp"
+
+namespace vb {
+namespace {
+
+/// Neighbour pairs of a full a×b×c block, counted once per direction class.
+std::size_t block_connections(long a, long b, long c) {
+  std::size_t total = 0;
+  for (const auto& d : neighbour_offsets())
+    total += std::size_t((a - std::abs(d[0])) * (b - std::abs(d[1])) * (c - std::abs(d[2])));
+  return total / 2;
+}
+
+TEST(Lattice, ThreeCubedBlockHas27ElementsAnd158Connections) {
+  const Lattice lat = build_lattice(voxelise_shapes(test::box_scene(3, 3, 3, 0.01)));
+  EXPECT_EQ(lat.element_count(), 27u);
+  EXPECT_EQ(lat.connection_count, 158u);  // 54 face + 72 edge + 32 corner
+  EXPECT_EQ(block_connections(3, 3, 3), 158u);
+}
+
+TEST(Lattice, BlockConnectionsMatchCountingFormula) {
+  for (auto [a, b, c] : {std::array{2, 2, 2}, std::array{4, 3, 5}, std::array{1, 1, 6}}) {
+    const Lattice lat = build_lattice(voxelise_shapes(test::box_scene(a, b, c, 0.002)));
+    EXPECT_EQ(lat.element_count(), std::size_t(a * b * c));
+    EXPECT_EQ(lat.connection_count, block_connections(a, b, c)) << a << "x" << b << "x" << c;
+  }
+}
+
+TEST(Lattice, SphereElementCountMatchesVolume) {
+  Scene s = test::box_scene(1, 1, 1, 0.001);
+  s.model.shapes[0].kind = ShapeSpec::Kind::Sphere;
+  s.model.shapes[0].center_m = Vec3(0.0003, -0.0002, 0.0001);
+  s.model.shapes[0].radius_m = 0.02;
+  const Lattice lat = build_lattice(voxelise_shapes(s));
+  const double expected = 4.0 / 3.0 * std::numbers::pi * std::pow(0.02 / 0.001, 3);
+  EXPECT_NEAR(double(lat.element_count()) / expected, 1.0, 0.01) << lat.element_count() << " vs " << expected;
+}
+
+TEST(Lattice, LaterShapesOverrideEarlierOnes) {
+  Scene s = test::box_scene(10, 10, 10, 0.001);
+  ShapeSpec inclusion;
+  inclusion.kind = ShapeSpec::Kind::Sphere;
+  inclusion.center_m = Vec3::Constant(0.005);
+  inclusion.radius_m = 0.002;
+  inclusion.label = "tumour";
+  s.model.shapes.push_back(inclusion);
+  const Lattice lat = build_lattice(voxelise_shapes(s));
+  EXPECT_EQ(lat.element_count(), 1000u);
+  ASSERT_EQ(lat.tissue_names.size(), 2u);
+  std::size_t tumour = 0;
+  for (std::size_t e = 0; e < lat.element_count(); ++e) {
+    const bool inside = (lat.rest_position(e) - inclusion.center_m).norm() <= inclusion.radius_m;
+    EXPECT_EQ(lat.tissue_of_element[e], inside ? 1 : 0) << "element " << e;
+    tumour += inside;
+  }
+  EXPECT_GT(tumour, 0u);
+}
+
+TEST(Lattice, HalfEllipsoidKeepsOneSide) {
+  Scene s = test::box_scene(1, 1, 1, 0.001);
+  ShapeSpec& half = s.model.shapes[0];
+  half.kind = ShapeSpec::Kind::HalfEllipsoid;
+  half.center_m = Vec3::Zero();
+  half.radii_m = Vec3(0.02, 0.015, 0.01);
+  half.axis = Vec3(0, 0, 1);
+  const Lattice lat = build_lattice(voxelise_shapes(s));
+  const double expected = 2.0 / 3.0 * std::numbers::pi * 20 * 15 * 10;
+  EXPECT_NEAR(double(lat.element_count()) / expected, 1.0, 0.03);
+  for (std::size_t e = 0; e < lat.element_count(); ++e) EXPECT_GE(lat.rest_position(e).z(), 0.0);
+}
+
+TEST(Lattice, DownsamplingMergesBlocks) {
+  const Scene s = test::box_scene(8, 8, 4, 0.001);
+  const Lattice fine = build_lattice(voxelise_shapes(s), 1);
+  const Lattice coarse = build_lattice(voxelise_shapes(s), 2);
+  EXPECT_EQ(fine.element_count(), 256u);
+  EXPECT_EQ(coarse.element_count(), 32u);
+  EXPECT_DOUBLE_EQ(coarse.spacing_m, 0.002);
+  // The coarse element centre is the centre of its 2×2×2 block of fine voxels.
+  EXPECT_NEAR(coarse.rest_position(0).x(), 0.5 * (fine.rest_position(0).x() + fine.rest_position(1).x()), 1e-12);
+}
+
+TEST(Lattice, VoxelIndexRoundTripsAndNeighboursAreSymmetric) {
+  const Lattice lat = build_lattice(voxelise_shapes(test::box_scene(4, 3, 5, 0.001)));
+  const auto& offsets = neighbour_offsets();
+  for (std::size_t e = 0; e < lat.element_count(); ++e) {
+    EXPECT_EQ(lat.element_of_voxel[lat.voxel_of_element[e]], std::int32_t(e));
+    const auto nb = lat.neighbours(e);
+    for (int d = 0; d < 26; ++d) {
+      if (nb[d] < 0) continue;
+      const auto back = lat.neighbours(std::size_t(nb[d]));
+      // the opposite direction of d points back to e
+      int opposite = -1;
+      for (int q = 0; q < 26; ++q)
+        if (offsets[q][0] == -offsets[d][0] && offsets[q][1] == -offsets[d][1] && offsets[q][2] == -offsets[d][2]) opposite = q;
+      EXPECT_EQ(back[opposite], std::int32_t(e));
+    }
+  }
+}
+
+TEST(Lattice, NoShapesIsAnError) {
+  Scene s = test::box_scene(2, 2, 2, 0.001);
+  s.model.shapes.clear();
+  EXPECT_THROW(voxelise_shapes(s), Error);
+}
+
+TEST(Lattice, ZeroSpacingIsAnError) {
+  Scene s = test::box_scene(2, 2, 2, 0.001);
+  s.model.spacing_m = 0;
+  try {
+    voxelise_shapes(s);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("model.spacing"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Lattice, ModelWithNoElementsIsAnError) {
+  Scene s = test::box_scene(1, 1, 1, 0.01);
+  s.model.shapes[0].kind = ShapeSpec::Kind::Sphere;
+  s.model.shapes[0].center_m = Vec3::Zero();  // a voxel corner: no voxel centre inside
+  s.model.shapes[0].radius_m = 1e-4;
+  const Lattice lat = build_lattice(voxelise_shapes(s));
+  EXPECT_EQ(lat.element_count(), 0u);
+  EXPECT_THROW(make_element_arrays(s, lat), Error);
+}
+
+}  // namespace
+}  // namespace vb

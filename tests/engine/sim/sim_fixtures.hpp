@@ -1,0 +1,62 @@
+#pragma once
+// Helpers for simulator tests: scenes built in code and one OpenCL context per test binary.
+#include <memory>
+
+#include "engine/lattice/voxelise.hpp"
+#include "engine/scene/scene.hpp"
+#include "engine/sim/element_setup.hpp"
+#include "engine/sim/opencl_runtime.hpp"
+
+namespace vb::test {
+
+/// The default device (PoCL in CI), created once.
+inline const ClContext& cl_context() {
+  static const std::unique_ptr<ClContext> cl = std::make_unique<ClContext>(select_device(""));
+  return *cl;
+}
+
+inline MaterialSpec material(const std::string& name, double E_pa, double density = 1000) {
+  MaterialSpec m;
+  m.name = name;
+  m.youngs_modulus_pa = E_pa;
+  m.density_kg_m3 = density;
+  return m;
+}
+
+/// Box of nx×ny×nz voxels of spacing h with its minimum corner at the origin, tissue "soft".
+inline Scene box_scene(int nx, int ny, int nz, double h, double E_pa = 3000) {
+  Scene s;
+  ShapeSpec box;
+  box.kind = ShapeSpec::Kind::Box;
+  box.min_m = Vec3::Zero();
+  box.max_m = h * Vec3(nx, ny, nz);
+  box.label = "soft";
+  s.model.spacing_m = h;
+  s.model.shapes.push_back(box);
+  s.materials["soft"] = material("soft", E_pa);
+  s.solver.dashpot_ratio = 0;
+  return s;
+}
+
+inline AnchorSpec halfspace_anchor(const std::string& name, const Vec3& point, const Vec3& normal) {
+  AnchorSpec a;
+  a.name = name;
+  a.kind = AnchorSpec::Kind::HalfSpace;
+  a.point_m = point;
+  a.normal = normal;
+  return a;
+}
+
+struct Model {
+  Lattice lattice;
+  ElementArrays elements;
+};
+
+inline Model make_model(const Scene& s) {
+  Model m;
+  m.lattice = build_lattice(voxelise_shapes(s), s.model.downsample);
+  m.elements = make_element_arrays(s, m.lattice);
+  return m;
+}
+
+}  // namespace vb::test
