@@ -26,11 +26,12 @@ LabelVolume voxelise_shapes(const Scene& scene) {
   }
   require(vol.tissue_names.size() < 255, "too many tissue labels (at most 254)", "model.shape");
 
-  // Voxel n covers [n·h, (n+1)·h); take every voxel whose centre can fall inside the bounds.
+  // Voxel n covers [n·h, (n+1)·h); take every voxel overlapping the bounds (the tolerance keeps
+  // a bound that lies on a voxel face from adding an empty layer).
   std::array<long, 3> first{}, count{};
   for (int a = 0; a < 3; ++a) {
-    first[a] = static_cast<long>(std::floor(lo[a] / h - 1e-9));
-    const long last = static_cast<long>(std::ceil(hi[a] / h + 1e-9));
+    first[a] = static_cast<long>(std::floor(lo[a] / h + 1e-9));
+    const long last = static_cast<long>(std::ceil(hi[a] / h - 1e-9));
     count[a] = std::max(1L, last - first[a]);
   }
   const double voxels = double(count[0]) * double(count[1]) * double(count[2]);
@@ -39,7 +40,7 @@ LabelVolume voxelise_shapes(const Scene& scene) {
   vol.dims = {int(count[0]), int(count[1]), int(count[2])};
   vol.spacing_m = h;
   vol.origin_m = Vec3((first[0] + 0.5) * h, (first[1] + 0.5) * h, (first[2] + 0.5) * h);
-  vol.labels.assign(vol.voxel_count(), 0);
+  vol.labels.assign(std::size_t(vol.dims[0]) * vol.dims[1] * vol.dims[2], 0);
 
   std::vector<std::uint8_t> label_of_shape;
   for (const ShapeSpec& s : model.shapes) {

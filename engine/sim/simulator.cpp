@@ -199,6 +199,11 @@ void Simulator::set_indenter_args(cl::Kernel& k, int a, double t_force, double t
 
 void Simulator::enqueue(cl::Kernel& k) const { cl_.queue.enqueueNDRangeKernel(k, cl::NullRange, global_, local_); }
 
+void Simulator::enqueue_check() const {
+  // check_state declares reqd_work_group_size, so its local size is always given
+  cl_.queue.enqueueNDRangeKernel(check_, cl::NullRange, global_, cl::NDRange(kCheckWorkGroup));
+}
+
 void Simulator::advance(std::int64_t steps) {
   const bool indenter = !scene_.indenters.empty();
   const double dt = dt_.dt_s;
@@ -226,7 +231,7 @@ StateCheck Simulator::check() {
   check_.setArg(0, u_);
   check_.setArg(1, v_);
   set_indenter_args(check_, 12, time_s(), time_s());
-  enqueue(check_);
+  enqueue_check();
   std::vector<double> p(check_groups_ * kCheckSlots);
   if (precision_ == Precision::Double) {
     cl_.queue.enqueueReadBuffer(partial_, CL_TRUE, 0, p.size() * sizeof(double), p.data());

@@ -56,6 +56,7 @@ class Simulator {
   void set_indenter_args(cl::Kernel& k, int first_arg, double t_force, double t_project);
   void set_lattice_args(cl::Kernel& k, int first_arg);
   void enqueue(cl::Kernel& k) const;
+  void enqueue_check() const;
   cl::Buffer make_state_buffer(const std::vector<double>& xyz, const std::vector<double>* w) const;
 
   const Scene& scene_;
@@ -74,7 +75,8 @@ class Simulator {
 
   cl::Buffer u_, v_, u_tmp_, v_tmp_, E_, cell_, grid_, partial_, partial_arg_;
   cl::Program program_;
-  cl::Kernel euler_, predict_, correct_, check_;
+  cl::Kernel euler_, predict_, correct_;
+  mutable cl::Kernel check_;
 };
 
 }  // namespace vb

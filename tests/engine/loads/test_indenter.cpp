@@ -11,7 +11,7 @@ namespace {
 
 TEST(Indenter, PlateReactionMatchesBlockStiffness) {
   const double h = 0.002, E = 3000;
-  const int nxy = 16, nz = 9;  // plus a held base layer
+  const int nxy = 12, nz = 7;  // plus a held base layer
   Scene s = test::box_scene(nxy, nxy, nz + 1, h, E);
   s.model.shapes[0].min_m.z() = -h;
   s.model.shapes[0].max_m.z() = nz * h;
@@ -25,8 +25,9 @@ TEST(Indenter, PlateReactionMatchesBlockStiffness) {
   plate.velocity_m_s = Vec3(0, 0, -0.01);
   plate.travel_time_s = depth / 0.01;
   s.indenters.push_back(plate);
-  s.solver.damping_per_s = 80;
+  s.solver.damping_per_s = 250;  // about critical for the first axial mode
   s.solver.dashpot_ratio = 0.1;
+  s.solver.precision = Precision::Double;  // a 1e-7 residual is below float round-off
   s.stop.equilibrium = 1e-7;
   s.stop.max_steps = 200000;
   const auto m = test::make_model(s);
@@ -38,10 +39,11 @@ TEST(Indenter, PlateReactionMatchesBlockStiffness) {
   EXPECT_EQ(out.summary.indenters[0].contact_elements, nxy * nxy);
 
   // Closed form for a block compressed between a frictionless plate and a held base, uniaxial
-  // stress over the voxel area (16 voxels across: surface columns make E_block ≈ 0.97·E).
+  // stress over the voxel area (12 voxels across: surface columns make E_block ≈ 0.96·E).
   const double L = top + 0.5 * h;  // from the held layer's centre to the plate
   const double expected = E * (nxy * h) * (nxy * h) * depth / L;
-  EXPECT_NEAR(-force.z() / expected, 1.0, 0.10) << "force " << force.transpose() << " expected " << expected;
+  // the tissue pushes the plate back (+z)
+  EXPECT_NEAR(force.z() / expected, 1.0, 0.10) << "force " << force.transpose() << " expected " << expected;
   EXPECT_LT(std::hypot(force.x(), force.y()), 1e-3 * std::abs(force.z()));
 }
 

@@ -21,7 +21,9 @@ class EffectiveModulus : public ::testing::TestWithParam<BlockSize> {};
 
 TEST_P(EffectiveModulus, StretchReproducesYoungsModulus) {
   const auto [nx, ny, nz] = GetParam();
-  const double h = 0.002, E = 5000, strain = 1e-4, nu = linear_spring::poisson_ratio;
+  // Springs are geometrically exact, so forces carry an O(ε) nonlinear part: ε = 1e-6 measures the
+  // small-strain limit, and 10ε is the tolerance of the exact bulk checks.
+  const double h = 0.002, E = 5000, strain = 1e-6, nu = linear_spring::poisson_ratio;
   Scene s = test::box_scene(nx, ny, nz, h, E);
   s.solver.precision = Precision::Double;
   s.solver.dashpot_ratio = 0.1;
@@ -45,8 +47,8 @@ TEST_P(EffectiveModulus, StretchReproducesYoungsModulus) {
     const bool end = ijk[2] == 0 || ijk[2] == nz - 1;
     const Vec3 fe(f[3 * e], f[3 * e + 1], f[3 * e + 2]);
     if (ijk[2] == nz - 1) face_force -= fe.z();  // springs pull the stretched end back
-    if (!lateral && !end) EXPECT_LT(fe.norm(), 1e-9 * column_force) << "interior element " << e;
-    if (!lateral && ijk[2] == nz - 1) EXPECT_NEAR(-fe.z() / column_force, 1.0, 1e-9) << "end column " << e;
+    if (!lateral && !end) EXPECT_LT(fe.norm(), 10 * strain * column_force) << "interior element " << e;
+    if (!lateral && ijk[2] == nz - 1) EXPECT_NEAR(-fe.z() / column_force, 1.0, 10 * strain) << "end column " << e;
   }
   const double E_block = face_force / (nx * ny * h * h * strain);
   RecordProperty("E_block_over_E", std::to_string(E_block / E));
