@@ -13,16 +13,20 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
   real4 f = (real4)(0);
 #pragma unroll
   for (int d = 0; d < 26; ++d) {
-    const int j = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
-    if (j < 0) continue;
+    // Branch-free: a missing neighbour reads the element itself and is masked out, so CPU
+    // compilers can vectorise across work-items.
+    const int jn = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
+    const real present = jn >= 0 ? (real)1 : (real)0;
+    const int j = jn >= 0 ? jn : (int)e;
     const real4 uj = u[j];
     const real4 r = (real4)(h * VB_DIR[d][0] + (uj.x - ui.x), h * VB_DIR[d][1] + (uj.y - ui.y),
                             h * VB_DIR[d][2] + (uj.z - ui.z), 0);
-    const real len = length(r);
-    const real4 n = r / len;
+    const real len_sq = dot3(r, r);
+    const real inv_len = rsqrt(len_sq);
+    const real4 n = r * inv_len;
     const real Ej = E[j];
-    const real k = VB_KAPPA[d] * h * (2 * Ei * Ej / (Ei + Ej));
-    real magnitude = k * (len - h * VB_DIR_LEN[d]);
+    const real k = present * VB_KAPPA[d] * h * (2 * Ei * Ej / (Ei + Ej));
+    real magnitude = k * (len_sq * inv_len - h * VB_DIR_LEN[d]);
 #if VB_DASHPOT
     const real reduced_mass = 1 / (ui.w + uj.w);
     magnitude += 2 * dashpot_ratio * sqrt(k * reduced_mass) * dot3(v[j] - vi, n);
