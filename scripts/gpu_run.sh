@@ -12,9 +12,9 @@ case "${1:-}" in
   prepare)
     build=${VOXBREAST_BUILD_DIR:-$root/build}
     rm -rf "$pkgs" && mkdir -p "$pkgs/bin" "$pkgs/lib" "$pkgs/deb"
-    cp "$build/apps/voxbreast" "$pkgs/bin/"
+    cp "$build/apps/voxbreast" "$build/tests/test_physics" "$pkgs/bin/"
     # Every shared library the binary needs except the C runtime the device already has.
-    ldd "$build/apps/voxbreast" | awk '/=> \// {print $3}' | grep -vE '/(libc|libm|libdl|libpthread|librt|ld-linux[^/]*)\.so' |
+    ldd "$build/apps/voxbreast" | awk '/=> \// {print $3}' | grep -vE '/(libc|libm|libdl|libpthread|librt|libresolv|ld-linux[^/]*)\.so' |
       while read -r lib; do cp -L "$lib" "$pkgs/lib/"; done
     (cd "$pkgs/deb" && apt-get download ocl-icd-libopencl1 clinfo >/dev/null)
     du -sh "$pkgs"
