@@ -3,8 +3,10 @@
 namespace vb {
 namespace {
 std::string compose(const std::string& what, const std::string& where, const std::string& hint) {
-  std::string s = where.empty() ? what : where + ": " + what;
-  if (!hint.empty()) s += " (" + hint + ")";
+  std::string s;  // appended piece by piece: GCC 12 warns falsely on chained + at -O3
+  if (!where.empty()) s.append(where).append(": ");
+  s.append(what);
+  if (!hint.empty()) s.append(" (").append(hint).append(")");
   return s;
 }
 }  // namespace

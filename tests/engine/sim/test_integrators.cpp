@@ -66,6 +66,8 @@ TEST(Integrators, HeunEnergyErrorIsSmallerThanSymplecticEuler) {
   const double omega_dt = 0.1;
   const double euler = max_energy_error(Integrator::SymplecticEuler, omega_dt, 5);
   const double heun = max_energy_error(Integrator::Heun, omega_dt, 5);
+  RecordProperty("euler_max_energy_error", std::to_string(euler));
+  RecordProperty("heun_max_energy_error", std::to_string(heun));
   // Symplectic Euler's energy oscillates by about ω·dt/2; Heun's grows by (ω·dt)⁴/8 per step.
   EXPECT_NEAR(euler, omega_dt / 2, 0.3 * omega_dt / 2);
   EXPECT_LT(heun, 0.5 * euler) << "heun " << heun << " euler " << euler;
@@ -79,6 +81,8 @@ TEST(Integrators, HeunIsSecondOrderAccurate) {
   const double heun_fine = max_energy_error(Integrator::Heun, 0.1, 3);
   const double euler_coarse = max_energy_error(Integrator::SymplecticEuler, 0.2, 3);
   const double euler_fine = max_energy_error(Integrator::SymplecticEuler, 0.1, 3);
+  RecordProperty("heun_ratio_dt_halved", std::to_string(heun_coarse / heun_fine));
+  RecordProperty("euler_ratio_dt_halved", std::to_string(euler_coarse / euler_fine));
   EXPECT_GT(heun_coarse / heun_fine, 6.0);
   EXPECT_LT(euler_coarse / euler_fine, 2.5);
 }
