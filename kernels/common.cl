@@ -2,6 +2,7 @@
 //   -DVB_DOUBLE=0|1   real = float | double
 //   -DVB_GRAVITY=0|1, -DVB_DASHPOT=0|1, -DVB_GLOBAL_DAMPING=0|1, -DVB_INDENTER=0|1
 //                     so only what the scene uses is compiled
+//   -DVB_RSQRT=0|1    1/|r| by rsqrt (GPUs) or 1/sqrt (CPUs, where rsqrt is a library call)
 //   -DVB_CHECK_WG=N   work-group size of the reduction kernel
 // and prepends the lattice tables (VB_DIR, VB_DIR_LEN, VB_KAPPA) generated from the host's
 // single definition (engine/sim/kernel_tables.cpp).

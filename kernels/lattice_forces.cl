@@ -22,7 +22,11 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
     const real4 r = (real4)(h * VB_DIR[d][0] + (uj.x - ui.x), h * VB_DIR[d][1] + (uj.y - ui.y),
                             h * VB_DIR[d][2] + (uj.z - ui.z), 0);
     const real len_sq = dot3(r, r);
-    const real inv_len = 1 / sqrt(len_sq);  // not rsqrt(): a slow library call on PoCL (3× here)
+#if VB_RSQRT
+    const real inv_len = rsqrt(len_sq);  // a hardware instruction on GPUs
+#else
+    const real inv_len = 1 / sqrt(len_sq);  // PoCL's rsqrt() is a slow library call (3× here)
+#endif
     const real4 n = r * inv_len;
     const real Ej = E[j];
     const real k = present * VB_KAPPA[d] * h * (2 * Ei * Ej / (Ei + Ej));

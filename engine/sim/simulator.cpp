@@ -106,6 +106,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_DASHPOT=" + std::to_string(scene.solver.dashpot_ratio > 0);
   options += " -DVB_GLOBAL_DAMPING=" + std::to_string(scene.solver.damping_per_s > 0);
   options += " -DVB_INDENTER=" + std::to_string(!scene.indenters.empty());
+  options += " -DVB_RSQRT=" + std::to_string(cl.info.is_gpu);
   options += " -DVB_CHECK_WG=" + std::to_string(kCheckWorkGroup);
   program_ = build_program(cl, {"common.cl", "lattice_forces.cl", "integrate.cl", "checks.cl"},
                            lattice_tables_source(), options);
