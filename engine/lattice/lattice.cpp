@@ -28,12 +28,12 @@ std::array<int, 3> Lattice::voxel_ijk(std::size_t e) const {
 
 Eigen::Vector3d Lattice::rest_position(std::size_t e) const {
   const auto ijk = voxel_ijk(e);
-  return origin_m + spacing_m * Eigen::Vector3d(ijk[0], ijk[1], ijk[2]);
+  return origin_m + spacing_m * (rotation * Eigen::Vector3d(ijk[0], ijk[1], ijk[2]));
 }
 
 Eigen::Matrix4d Lattice::affine() const {
   Eigen::Matrix4d a = Eigen::Matrix4d::Identity();
-  a.topLeftCorner<3, 3>() *= spacing_m;
+  a.topLeftCorner<3, 3>() = spacing_m * rotation;
   a.topRightCorner<3, 1>() = origin_m;
   return a;
 }
@@ -57,7 +57,8 @@ LabelVolume downsample_volume(const LabelVolume& in, int f) {
   LabelVolume out;
   for (int a = 0; a < 3; ++a) out.dims[a] = (in.dims[a] + f - 1) / f;
   out.spacing_m = in.spacing_m * f;
-  out.origin_m = in.origin_m + Eigen::Vector3d::Constant(0.5 * (f - 1) * in.spacing_m);
+  out.rotation = in.rotation;
+  out.origin_m = in.origin_m + in.rotation * Eigen::Vector3d::Constant(0.5 * (f - 1) * in.spacing_m);
   out.tissue_names = in.tissue_names;
   out.labels.assign(std::size_t(out.dims[0]) * out.dims[1] * out.dims[2], 0);
   std::vector<int> votes(in.tissue_names.size() + 1);
@@ -90,6 +91,7 @@ Lattice build_lattice(const LabelVolume& input, int downsample) {
   lat.dims = vol.dims;
   lat.spacing_m = vol.spacing_m;
   lat.origin_m = vol.origin_m;
+  lat.rotation = vol.rotation;
   lat.tissue_names = vol.tissue_names;
   lat.element_of_voxel.assign(vol.voxel_count(), -1);
   for (std::size_t v = 0; v < vol.voxel_count(); ++v) {

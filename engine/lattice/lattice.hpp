@@ -14,6 +14,9 @@ struct LabelVolume {
   std::array<int, 3> dims{0, 0, 0};          ///< voxels along x, y, z
   double spacing_m = 0;                      ///< isotropic voxel edge (m)
   Eigen::Vector3d origin_m = Eigen::Vector3d::Zero();  ///< world centre of voxel (0, 0, 0) (m)
+  /// world direction of each voxel axis (columns, orthonormal): identity for analytic shapes,
+  /// the image's direction cosines for (possibly oblique) CT volumes
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   std::vector<std::uint8_t> labels;          ///< dims[0]·dims[1]·dims[2], x fastest
   std::vector<std::string> tissue_names;     ///< label t ≥ 1 → tissue_names[t - 1]
 
@@ -29,6 +32,9 @@ struct Lattice {
   std::array<int, 3> dims{0, 0, 0};  ///< voxel grid the elements live on
   double spacing_m = 0;              ///< element spacing (m)
   Eigen::Vector3d origin_m = Eigen::Vector3d::Zero();  ///< world centre of voxel (0,0,0) (m)
+  /// world direction of each lattice axis (columns, orthonormal). The simulator works in the
+  /// lattice frame, where a world vector w is rotationᵀ·w.
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   std::vector<std::uint32_t> voxel_of_element;  ///< n_elements, linear voxel index (x fastest)
   std::vector<std::int32_t> element_of_voxel;   ///< dims product, -1 where empty
   std::vector<std::uint8_t> tissue_of_element;  ///< n_elements, index into tissue_names

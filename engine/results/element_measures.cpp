@@ -14,7 +14,7 @@ Eigen::Matrix3d deformation_gradient(const Lattice& lattice, const std::vector<d
   for (int d = 0; d < 26; ++d) {
     if (nb[d] < 0) continue;
     const std::size_t j = std::size_t(nb[d]);
-    const Eigen::Vector3d dX = h * Eigen::Vector3d(offsets[d][0], offsets[d][1], offsets[d][2]);
+    const Eigen::Vector3d dX = h * (lattice.rotation * Eigen::Vector3d(offsets[d][0], offsets[d][1], offsets[d][2]));
     const Eigen::Vector3d dx = dX + Eigen::Vector3d(u[3 * j], u[3 * j + 1], u[3 * j + 2]) - ue;
     A += dx * dX.transpose();
     B += dX * dX.transpose();

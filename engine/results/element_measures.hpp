@@ -9,7 +9,7 @@ namespace vb {
 
 /// Deformation gradient of an element by least squares over its existing connections:
 /// F = (Σ Δx ΔXᵀ)(Σ ΔX ΔXᵀ)⁻¹, exact for affine motion and valid at boundaries. Identity when the
-/// neighbours do not span 3-D. `u` is n×3 (m).
+/// neighbours do not span 3-D. `u` is n×3 (m), world frame; F is in the world frame.
 Eigen::Matrix3d deformation_gradient(const Lattice& lattice, const std::vector<double>& u, std::size_t element);
 
 /// Fills state.volumetric_strain (det F − 1), state.equivalent_strain (von Mises equivalent of

@@ -20,7 +20,7 @@ HostReference::HostReference(const Lattice& lattice, const ElementArrays& elemen
       v(elements.displacement_m.size(), 0.0),
       lattice_(lattice),
       el_(elements),
-      gravity_(scene.gravity.active ? scene.gravity.acceleration_m_s2 : Vec3::Zero()),
+      gravity_(lattice.rotation.transpose() * (scene.gravity.active ? scene.gravity.acceleration_m_s2 : Vec3::Zero())),
       damping_(scene.solver.damping_per_s),
       dashpot_ratio_(scene.solver.dashpot_ratio),
       integrator_(scene.solver.integrator) {

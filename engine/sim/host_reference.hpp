@@ -1,7 +1,8 @@
 #pragma once
 /// Double-precision host implementation of the lattice forces and integrators: the reference
 /// the OpenCL kernels are tested against, and the source of per-connection stiffness for the
-/// time-step bound. Deliberately plain loops; not for production runs.
+/// time-step bound. Deliberately plain loops; not for production runs. Vectors (u, v, forces)
+/// are in the lattice frame (equal to the world frame for axis-aligned lattices).
 #include <array>
 #include <vector>
 

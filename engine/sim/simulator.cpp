@@ -86,7 +86,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     std::vector<float> E(el.youngs_modulus_pa.begin(), el.youngs_modulus_pa.end());
     E_ = cl::Buffer(cl.context, flags_ro, n_ * sizeof(float), E.data());
   }
-  u_ = make_state_buffer(el.displacement_m, &el.inverse_mass);
+  u_ = make_state_buffer(to_lattice_frame(el.displacement_m), &el.inverse_mass);
   v_ = make_state_buffer(std::vector<double>(3 * n_, 0.0), nullptr);
   u_tmp_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
   v_tmp_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
@@ -122,7 +122,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   for (cl::Kernel* k : {&euler_, &predict_, &correct_}) {
     if (!(*k)()) continue;
     set_lattice_args(*k, 4);
-    if (precision_ == Precision::Double) k->setArg(19, dt_.dt_s); else k->setArg(19, float(dt_.dt_s));
+    set_real(*k, 19, dt_.dt_s);
     k->setArg(20, cl_uint(n_));
   }
   if (heun) {
@@ -154,22 +154,27 @@ void set_vec(cl::Kernel& k, int index, const Vec3& v) {
 }
 }  // namespace
 
+void Simulator::set_real(cl::Kernel& k, int index, double x) const {
+  if (precision_ == Precision::Double) k.setArg(index, x); else k.setArg(index, float(x));
+}
+
+void Simulator::set_world_vector(cl::Kernel& k, int index, const Vec3& world) const {
+  const Vec3 x = lattice_.rotation.transpose() * world;  // kernels work in the lattice frame
+  if (precision_ == Precision::Double) set_vec<double, cl_double4>(k, index, x);
+  else set_vec<float, cl_float4>(k, index, x);
+}
+
 void Simulator::set_lattice_args(cl::Kernel& k, int a) {
-  const bool dbl = precision_ == Precision::Double;
-  auto real = [&](int i, double x) { dbl ? k.setArg(i, x) : k.setArg(i, float(x)); };
-  auto vec = [&](int i, const Vec3& x) {
-    dbl ? set_vec<double, cl_double4>(k, i, x) : set_vec<float, cl_float4>(k, i, x);
-  };
   k.setArg(a + 0, E_);
   k.setArg(a + 1, cell_);
   k.setArg(a + 2, grid_);
   k.setArg(a + 3, cl_int(stride_y_));
   k.setArg(a + 4, cl_int(stride_z_));
-  real(a + 5, lattice_.spacing_m);
-  real(a + 6, scene_.solver.dashpot_ratio);
-  vec(a + 7, scene_.gravity.active ? scene_.gravity.acceleration_m_s2 : Vec3::Zero());
-  real(a + 8, scene_.solver.damping_per_s);
-  vec(a + 9, lattice_.origin_m);
+  set_real(k, a + 5, lattice_.spacing_m);
+  set_real(k, a + 6, scene_.solver.dashpot_ratio);
+  set_world_vector(k, a + 7, scene_.gravity.active ? scene_.gravity.acceleration_m_s2 : Vec3::Zero());
+  set_real(k, a + 8, scene_.solver.damping_per_s);
+  set_world_vector(k, a + 9, lattice_.origin_m);
   set_indenter_args(k, a + 10, 0.0, 0.0);
 }
 
@@ -179,23 +184,18 @@ Vec3 Simulator::indenter_position(double t) const {
 }
 
 void Simulator::set_indenter_args(cl::Kernel& k, int a, double t_force, double t_project) {
-  const bool dbl = precision_ == Precision::Double;
-  auto real = [&](int i, double x) { dbl ? k.setArg(i, x) : k.setArg(i, float(x)); };
-  auto vec = [&](int i, const Vec3& x) {
-    dbl ? set_vec<double, cl_double4>(k, i, x) : set_vec<float, cl_float4>(k, i, x);
-  };
   if (scene_.indenters.empty()) {
-    for (int i = 0; i < 4; ++i) vec(a + i, Vec3::Zero());
-    real(a + 4, 0.0);
+    for (int i = 0; i < 4; ++i) set_world_vector(k, a + i, Vec3::Zero());
+    set_real(k, a + 4, 0.0);
     return;
   }
   const IndenterSpec& ind = scene_.indenters.front();
   const bool moving = t_project < ind.travel_time_s;
-  vec(a + 0, indenter_position(t_force));
-  vec(a + 1, indenter_position(t_project));
-  vec(a + 2, ind.normal);
-  vec(a + 3, moving ? ind.velocity_m_s : Vec3::Zero());
-  real(a + 4, ind.kind == IndenterSpec::Kind::Plate ? -1.0 : ind.radius_m);
+  set_world_vector(k, a + 0, indenter_position(t_force));
+  set_world_vector(k, a + 1, indenter_position(t_project));
+  set_world_vector(k, a + 2, ind.normal);
+  set_world_vector(k, a + 3, moving ? ind.velocity_m_s : Vec3::Zero());
+  set_real(k, a + 4, ind.kind == IndenterSpec::Kind::Plate ? -1.0 : ind.radius_m);
 }
 
 void Simulator::enqueue(cl::Kernel& k) const { cl_.queue.enqueueNDRangeKernel(k, cl::NullRange, global_, local_); }
@@ -254,42 +254,59 @@ StateCheck Simulator::check() {
     }
     c.kinetic_energy_j += q[2];
     c.max_displacement_m = std::max(c.max_displacement_m, q[3]);
-    c.indenter_force_n += Vec3(q[4], q[5], q[6]);
+    c.indenter_force_n += lattice_.rotation * Vec3(q[4], q[5], q[6]);
     c.contact_elements += std::llround(q[7]);
     c.nonfinite_elements += std::llround(q[8]);
   }
   return c;
 }
 
+template <typename T>
+void Simulator::read_xyz(const cl::Buffer& buffer, std::vector<double>& world) const {
+  std::vector<T> data(4 * n_);
+  cl_.queue.enqueueReadBuffer(buffer, CL_TRUE, 0, data.size() * sizeof(T), data.data());
+  unpack4(data, world);
+  for (std::size_t e = 0; e < n_; ++e) {
+    const Vec3 w = lattice_.rotation * Vec3(world[3 * e], world[3 * e + 1], world[3 * e + 2]);
+    for (int c = 0; c < 3; ++c) world[3 * e + c] = w[c];
+  }
+}
+
+template <typename T>
+void Simulator::write_xyz(const cl::Buffer& buffer, const std::vector<double>& world, const std::vector<double>* w) const {
+  auto data = pack4<T>(to_lattice_frame(world), w);
+  cl_.queue.enqueueWriteBuffer(buffer, CL_TRUE, 0, data.size() * sizeof(T), data.data());
+}
+
+std::vector<double> Simulator::to_lattice_frame(const std::vector<double>& world) const {
+  std::vector<double> out(world.size());
+  const Eigen::Matrix3d Rt = lattice_.rotation.transpose();
+  for (std::size_t e = 0; e < world.size() / 3; ++e) {
+    const Vec3 x = Rt * Vec3(world[3 * e], world[3 * e + 1], world[3 * e + 2]);
+    for (int c = 0; c < 3; ++c) out[3 * e + c] = x[c];
+  }
+  return out;
+}
+
 void Simulator::download(std::vector<double>& u, std::vector<double>& v) const {
   if (precision_ == Precision::Double) {
-    std::vector<double> a(4 * n_), b(4 * n_);
-    cl_.queue.enqueueReadBuffer(u_, CL_TRUE, 0, a.size() * sizeof(double), a.data());
-    cl_.queue.enqueueReadBuffer(v_, CL_TRUE, 0, b.size() * sizeof(double), b.data());
-    unpack4(a, u);
-    unpack4(b, v);
+    read_xyz<double>(u_, u);
+    read_xyz<double>(v_, v);
   } else {
-    std::vector<float> a(4 * n_), b(4 * n_);
-    cl_.queue.enqueueReadBuffer(u_, CL_TRUE, 0, a.size() * sizeof(float), a.data());
-    cl_.queue.enqueueReadBuffer(v_, CL_TRUE, 0, b.size() * sizeof(float), b.data());
-    unpack4(a, u);
-    unpack4(b, v);
+    read_xyz<float>(u_, u);
+    read_xyz<float>(v_, v);
   }
 }
 
 void Simulator::upload(const std::vector<double>& u, const std::vector<double>& v) {
   require(u.size() == 3 * n_ && v.size() == 3 * n_, "state size does not match the model");
-  auto write = [&](const cl::Buffer& buf, const std::vector<double>& xyz, const std::vector<double>* w) {
-    if (precision_ == Precision::Double) {
-      auto d = pack4<double>(xyz, w);
-      cl_.queue.enqueueWriteBuffer(buf, CL_TRUE, 0, d.size() * sizeof(double), d.data());
-    } else {
-      auto d = pack4<float>(xyz, w);
-      cl_.queue.enqueueWriteBuffer(buf, CL_TRUE, 0, d.size() * sizeof(float), d.data());
-    }
-  };
-  write(u_, u, &inverse_mass_);
-  write(v_, v, nullptr);
+  if (precision_ == Precision::Double) {
+    write_xyz<double>(u_, u, &inverse_mass_);
+    write_xyz<double>(v_, v, nullptr);
+  } else {
+    write_xyz<float>(u_, u, &inverse_mass_);
+    write_xyz<float>(v_, v, nullptr);
+  }
 }
 
 std::vector<double> Simulator::lattice_forces() const {
@@ -297,24 +314,13 @@ std::vector<double> Simulator::lattice_forces() const {
   cl::Buffer f(cl_.context, CL_MEM_WRITE_ONLY, 4 * real_size_ * n_);
   k.setArg(0, u_); k.setArg(1, v_); k.setArg(2, E_); k.setArg(3, cell_); k.setArg(4, grid_);
   k.setArg(5, cl_int(stride_y_)); k.setArg(6, cl_int(stride_z_));
-  if (precision_ == Precision::Double) {
-    k.setArg(7, lattice_.spacing_m); k.setArg(8, scene_.solver.dashpot_ratio);
-  } else {
-    k.setArg(7, float(lattice_.spacing_m)); k.setArg(8, float(scene_.solver.dashpot_ratio));
-  }
+  set_real(k, 7, lattice_.spacing_m);
+  set_real(k, 8, scene_.solver.dashpot_ratio);
   k.setArg(9, f);
   k.setArg(10, cl_uint(n_));
   enqueue(k);
   std::vector<double> out;
-  if (precision_ == Precision::Double) {
-    std::vector<double> a(4 * n_);
-    cl_.queue.enqueueReadBuffer(f, CL_TRUE, 0, a.size() * sizeof(double), a.data());
-    unpack4(a, out);
-  } else {
-    std::vector<float> a(4 * n_);
-    cl_.queue.enqueueReadBuffer(f, CL_TRUE, 0, a.size() * sizeof(float), a.data());
-    unpack4(a, out);
-  }
+  if (precision_ == Precision::Double) read_xyz<double>(f, out); else read_xyz<float>(f, out);
   return out;
 }
 

@@ -36,10 +36,10 @@ class Simulator {
   /// Runs the reduction kernel on the current state and waits for it.
   StateCheck check();
 
-  /// Current state as n×3 doubles.
+  /// Current state as n×3 doubles in the world frame.
   void download(std::vector<double>& u_m, std::vector<double>& v_m_s) const;
   void upload(const std::vector<double>& u_m, const std::vector<double>& v_m_s);
-  /// Lattice spring + dashpot forces at the current state (n×3, N); for tests.
+  /// Lattice spring + dashpot forces at the current state (n×3, N, world frame); for tests.
   std::vector<double> lattice_forces() const;
 
   double dt_s() const { return dt_.dt_s; }
@@ -55,6 +55,14 @@ class Simulator {
  private:
   void set_indenter_args(cl::Kernel& k, int first_arg, double t_force, double t_project);
   void set_lattice_args(cl::Kernel& k, int first_arg);
+  void set_real(cl::Kernel& k, int index, double x) const;
+  /// sets a world vector, rotated into the lattice frame the kernels work in
+  void set_world_vector(cl::Kernel& k, int index, const Vec3& world) const;
+  template <typename T>
+  void read_xyz(const cl::Buffer& buffer, std::vector<double>& world) const;
+  template <typename T>
+  void write_xyz(const cl::Buffer& buffer, const std::vector<double>& world, const std::vector<double>* w) const;
+  std::vector<double> to_lattice_frame(const std::vector<double>& world) const;
   void enqueue(cl::Kernel& k) const;
   void enqueue_check() const;
   cl::Buffer make_state_buffer(const std::vector<double>& xyz, const std::vector<double>* w) const;
