@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -150,11 +151,27 @@ double metres_per_unit(const nifti_image& nim, const std::string& path) {
   }
 }
 
-/// nifti_clib quietly replaces pixdim <= 0 by 1 in the qform, so check before using it.
-void check_pixdim(const nifti_image& nim, const std::string& path) {
-  for (int d = 1; d <= 3; ++d)
-    require(std::isfinite(nim.pixdim[d]) && nim.pixdim[d] > 0.0,
-            "voxel spacing pixdim[" + std::to_string(d) + "] = " + std::to_string(nim.pixdim[d]) +
+/// pixdim[1..3] as stored: nifti_image's copy has zeros already replaced by 1.
+std::array<double, 3> stored_pixdim(const std::string& path) {
+  int version = 0;
+  const std::unique_ptr<void, void (*)(void*)> header(
+      nifti_read_header(path.c_str(), &version, /*check=*/1), std::free);
+  require(header != nullptr && (version == 1 || version == 2), "cannot read the NIfTI header",
+          path);
+  const auto pixdim = [&](auto* h) {
+    if (h->sizeof_hdr != int(sizeof *h)) swap_nifti_header(h, version);  // other byte order
+    return std::array<double, 3>{h->pixdim[1], h->pixdim[2], h->pixdim[3]};
+  };
+  return version == 1 ? pixdim(static_cast<nifti_1_header*>(header.get()))
+                      : pixdim(static_cast<nifti_2_header*>(header.get()));
+}
+
+/// The qform and the bare-pixdim fallback take the spacing from pixdim.
+void check_pixdim(const std::string& path) {
+  const std::array<double, 3> pixdim = stored_pixdim(path);
+  for (std::size_t d = 0; d < 3; ++d)
+    require(std::isfinite(pixdim[d]) && pixdim[d] > 0.0,
+            "voxel spacing pixdim[" + std::to_string(d + 1) + "] = " + std::to_string(pixdim[d]) +
                 " is not positive",
             path);
 }
@@ -162,7 +179,7 @@ void check_pixdim(const nifti_image& nim, const std::string& path) {
 /// Voxel index -> file world (RAS, file unit): sform, else qform, else diag(pixdim).
 Eigen::Matrix4d file_affine(const nifti_image& nim, const std::string& path) {
   if (nim.sform_code > 0) return to_eigen(nim.sto_xyz);
-  check_pixdim(nim, path);
+  check_pixdim(path);
   if (nim.qform_code > 0) return to_eigen(nim.qto_xyz);
   return Eigen::Vector4d(nim.pixdim[1], nim.pixdim[2], nim.pixdim[3], 1.0).asDiagonal();
 }

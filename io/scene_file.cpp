@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "engine/error.hpp"
+#include "engine/material/default_materials.hpp"
 #include "engine/loads/posture.hpp"
 
 namespace vb {
@@ -229,6 +230,37 @@ class Section {
     return node->as_string()->get();
   }
 
+  std::optional<bool> boolean(std::string_view key) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    if (!node->is_boolean()) wrong_type(key, *node, "true or false");
+    return node->as_boolean()->get();
+  }
+
+  /// An array of strings; absent → nullopt.
+  std::optional<std::vector<std::string>> strings(std::string_view key) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    const toml::array* array = node->as_array();
+    const auto is_string = [](const toml::node& n) { return n.is_string(); };
+    if (!array || !std::all_of(array->begin(), array->end(), is_string)) {
+      wrong_type(key, *node, "an array of strings");
+    }
+    std::vector<std::string> out;
+    for (const toml::node& n : *array) out.push_back(n.as_string()->get());
+    return out;
+  }
+
+  /// Keys of this table with their sections-free values, in file order (for key → value maps).
+  std::vector<std::string> keys() const {
+    std::vector<std::pair<int, std::string>> found;
+    for (const auto& entry : *table_) found.emplace_back(line_of(entry.first.source()), std::string(entry.first.str()));
+    std::stable_sort(found.begin(), found.end());
+    std::vector<std::string> out;
+    for (auto& f : found) out.push_back(std::move(f.second));
+    return out;
+  }
+
   /// A finite number; integers are accepted.
   std::optional<double> number(std::string_view key) const {
     const toml::node* node = find(key);
@@ -393,15 +425,73 @@ ShapeSpec read_shape(const Section& s) {
   return shape;
 }
 
+/// `[model.label_table]`: label value (a key, e.g. "3") → tissue name.
+std::map<int, std::string> read_label_table(const Section& s) {
+  std::map<int, std::string> table;
+  for (const std::string& key : s.keys()) {
+    char* end = nullptr;
+    const long value = std::strtol(key.c_str(), &end, 10);
+    if (key.empty() || *end != '\0' || value < 0 || value > 65535) {
+      s.fail(key, "label table keys are label values 0..65535", "write e.g. 3 = \"fibroglandular\"");
+    }
+    table[int(value)] = s.required(key, s.text(key));
+  }
+  if (table.empty()) s.fail("", "the label table is empty", "map label values to tissue names");
+  return table;
+}
+
+HuClass read_hu_class(const Section& s) {
+  s.check_keys({"tissue", "min", "max"});
+  HuClass c;
+  c.line = s.line();
+  c.tissue = s.required("tissue", s.text("tissue"));
+  c.min_hu = s.required("min", s.number("min"));
+  c.max_hu = s.required("max", s.number("max"));
+  if (c.max_hu <= c.min_hu) s.fail("max", "must be greater than min");
+  return c;
+}
+
+/// Image models: a CT (NIfTI file or DICOM folder) classified by a label volume or HU classes.
+void read_image_model(const Section& s, ModelSpec& model) {
+  model.image_path = *s.text("image");
+  model.series_uid = s.text("series").value_or("");
+  model.allow_gaps = s.boolean("allow_gaps").value_or(false);
+  model.labels_path = s.text("labels").value_or("");
+  if (const auto table = s.table("label_table")) model.label_table = read_label_table(*table);
+  for (const Section& c : s.tables("hu_class")) model.hu_classes.push_back(read_hu_class(c));
+  const bool by_labels = !model.labels_path.empty();
+  if (by_labels == !model.hu_classes.empty()) {
+    s.fail("image", "an image model needs exactly one of 'labels' (with [model.label_table]) or [[model.hu_class]]");
+  }
+  if (by_labels && model.label_table.empty()) s.fail("labels", "'labels' needs a [model.label_table]");
+  if (!by_labels && !model.label_table.empty()) s.fail("label_table", "[model.label_table] needs 'labels'");
+  model.keep = s.strings("keep").value_or(std::vector<std::string>{});
+  const std::optional<Vec3> lo = s.vec3("roi_min"), hi = s.vec3("roi_max");
+  if (lo.has_value() != hi.has_value()) s.fail(lo ? "roi_max" : "roi_min", "roi_min and roi_max go together");
+  if (lo) {
+    if (!(hi->array() > lo->array()).all()) s.fail("roi_max", "must exceed roi_min in every component");
+    model.roi_m = std::make_pair(*lo, *hi);
+  }
+  model.spacing_m = s.positive("spacing").value_or(0.0);
+}
+
 ModelSpec read_model(const Section& s) {
-  constexpr std::string_view kShapesOnly = "analytic shapes only in this version";
-  s.check_keys({"spacing", "downsample", "shape"},
-               {{"image", kShapesOnly}, {"labels", kShapesOnly}, {"hu_thresholds", kShapesOnly}});
+  s.check_keys({"spacing", "downsample", "shape", "image", "series", "allow_gaps", "labels", "label_table",
+                "hu_class", "keep", "roi_min", "roi_max"});
   ModelSpec model;
+  model.line = s.line();
   model.downsample = s.integer<int>("downsample", 1).value_or(model.downsample);
   for (const Section& shape : s.tables("shape")) model.shapes.push_back(read_shape(shape));
+  if (s.find("image")) {
+    if (!model.shapes.empty()) s.fail("image", "a model comes from an image or from shapes, not both");
+    read_image_model(s, model);
+    return model;
+  }
+  for (const char* key : {"series", "allow_gaps", "labels", "label_table", "hu_class", "keep", "roi_min", "roi_max"}) {
+    if (s.find(key)) s.fail(key, "applies to image models only", "add model.image or remove it");
+  }
   if (model.shapes.empty()) {
-    s.fail("shape", "the model has no shapes", "add [[model.shape]] tables; see docs/SCENE.md");
+    s.fail("shape", "the model has no shapes", "add [[model.shape]] tables or model.image; see docs/SCENE.md");
   }
   model.spacing_m = s.required("spacing", s.positive("spacing"));
   return model;
@@ -417,9 +507,11 @@ void check_law(const Section& s, const std::string& law) {
   s.fail("law", "unknown law '" + law + "'", choice_hint(law, available));
 }
 
+/// A tissue with a default (docs/MATERIALS.md) may give only the values it changes.
 MaterialSpec read_material(const std::string& name, const Section& s) {
-  s.check_keys({"law", "E", "density", "nu"});
-  MaterialSpec m;
+  s.check_keys({"law", "E", "density", "nu", "rigid"});
+  const std::optional<MaterialSpec> fallback = default_material(name);
+  MaterialSpec m = fallback.value_or(MaterialSpec{});
   m.name = name;
   m.line = s.line();
   m.law = s.text("law").value_or(m.law);
@@ -430,7 +522,10 @@ MaterialSpec read_material(const std::string& name, const Section& s) {
         "linear lattice springs have Poisson ratio 0.25 fixed; 'nu' applies to hyperelastic laws",
         "remove 'nu'");
   }
-  m.youngs_modulus_pa = s.required("E", s.positive("E"));
+  m.rigid = s.boolean("rigid").value_or(m.rigid);
+  const std::optional<double> E = s.positive("E");
+  if (!E && !fallback && !m.rigid) s.fail("E", "missing required key", "'" + name + "' has no default material");
+  m.youngs_modulus_pa = E.value_or(fallback ? fallback->youngs_modulus_pa : 1.0);
   m.density_kg_m3 = s.positive("density").value_or(m.density_kg_m3);
   return m;
 }
@@ -580,17 +675,35 @@ OutputSpec read_output(const Section& s) {
   return out;
 }
 
-/// Runs after everything is read: shapes may come before the materials they name.
-void check_labels(const Scene& scene, const std::string& source) {
+/// Runs after everything is read: shapes may come before the materials they name. A tissue
+/// needs a [materials.X] table unless it has a default material.
+void check_labels(Scene& scene, const std::string& source) {
   Keys names;
   for (const auto& entry : scene.materials) names.push_back(entry.first);
-  for (std::size_t i = 0; i < scene.model.shapes.size(); ++i) {
-    const ShapeSpec& shape = scene.model.shapes[i];
-    if (scene.materials.count(shape.label)) continue;
-    const std::string guess = did_you_mean(shape.label, names);
-    throw Error("label '" + shape.label + "' names no [materials." + shape.label + "] table",
-                where_string(source, shape.line, "model.shape[" + std::to_string(i) + "].label"),
-                guess.empty() ? "define [materials." + shape.label + "] with 'E'" : guess);
+  for (const std::string& d : default_material_names()) names.push_back(d);
+  auto resolve = [&](const std::string& tissue, int line, const std::string& key) {
+    if (scene.materials.count(tissue)) return;
+    if (auto d = default_material(tissue)) {
+      scene.materials[tissue] = *d;
+      return;
+    }
+    const std::string guess = did_you_mean(tissue, names);
+    throw Error("label '" + tissue + "' names no [materials." + tissue + "] table and has no default material",
+                where_string(source, line, key), guess.empty() ? "define [materials." + tissue + "] with 'E'" : guess);
+  };
+  for (std::size_t i = 0; i < scene.model.shapes.size(); ++i)
+    resolve(scene.model.shapes[i].label, scene.model.shapes[i].line, "model.shape[" + std::to_string(i) + "].label");
+  for (const auto& [value, tissue] : scene.model.label_table)
+    resolve(tissue, scene.model.line, "model.label_table." + std::to_string(value));
+  for (std::size_t i = 0; i < scene.model.hu_classes.size(); ++i)
+    resolve(scene.model.hu_classes[i].tissue, scene.model.hu_classes[i].line, "model.hu_class[" + std::to_string(i) + "].tissue");
+}
+
+/// Relative data paths in a scene file are relative to the scene file's folder.
+void resolve_paths(ModelSpec& model, const std::string& scene_path) {
+  const std::filesystem::path base = std::filesystem::path(scene_path).parent_path();
+  for (std::string* p : {&model.image_path, &model.labels_path}) {
+    if (!p->empty() && std::filesystem::path(*p).is_relative()) *p = (base / *p).lexically_normal().string();
   }
 }
 
@@ -645,6 +758,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
 Scene parse_scene_file(const std::string& path) {
   Scene scene = parse_scene_text(read_text_file(path), path);
   scene.source_path = path;
+  resolve_paths(scene.model, path);
   return scene;
 }
 

@@ -26,10 +26,30 @@ struct ShapeSpec {
   int line = 0;               ///< scene-file line, for error messages
 };
 
+/// Hounsfield-unit class: CT voxels with min ≤ HU < max become `tissue`.
+struct HuClass {
+  std::string tissue;
+  double min_hu = 0, max_hu = 0;
+  int line = 0;
+};
+
 struct ModelSpec {
-  double spacing_m = 0;  ///< voxel edge length for analytic shapes (m)
+  double spacing_m = 0;  ///< lattice spacing (m); for images 0 means the image's largest spacing
   int downsample = 1;    ///< merge downsample³ voxels into one element
   std::vector<ShapeSpec> shapes;
+
+  // CT image models (instead of shapes)
+  std::string image_path;   ///< CT as a NIfTI file or a DICOM series folder (resolved path)
+  std::string series_uid;   ///< DICOM series to use when the folder holds several
+  bool allow_gaps = false;  ///< accept uneven DICOM slice spacing (with a warning)
+  std::string labels_path;  ///< label volume (NIfTI) on the CT grid
+  std::map<int, std::string> label_table;  ///< label value → tissue name
+  std::vector<HuClass> hu_classes;         ///< alternative to a label volume
+  std::vector<std::string> keep;           ///< tissues to build (empty: all classified tissues)
+  std::optional<std::pair<Vec3, Vec3>> roi_m;  ///< world box (min, max) the model is cropped to
+  int line = 0;
+
+  bool from_image() const { return !image_path.empty(); }
 };
 
 /// Per-tissue material. Issue 4 adds hyperelastic laws; the core knows linear springs.
@@ -38,6 +58,7 @@ struct MaterialSpec {
   std::string law = "linear";
   double youngs_modulus_pa = 0;
   double density_kg_m3 = 1000;
+  bool rigid = false;  ///< held in place (bone): no motion, anchors its soft neighbours
   int line = 0;
 };
 

@@ -317,8 +317,9 @@ std::vector<ErrorCase> error_cases() {
        {"expected an integer"}},
       {"NegativeModulus", with("E = 3000.0", "E = -5.0"), "materials.adipose.E", 9, {"> 0"}},
       {"InfiniteModulus", with("E = 3000.0", "E = inf"), "materials.adipose.E", 9, {"finite"}},
-      {"MissingModulus", with("E = 3000.0", "density = 900.0"), "materials.adipose.E", 8,
-       {"missing required key"}},
+      {"MissingModulusWithoutDefault",
+       with("[materials.adipose]\nE = 3000.0", "[materials.adipose]\nE = 3000.0\n[materials.gel]\ndensity = 900.0"),
+       "materials.gel.E", 10, {"missing required key", "no default material"}},
       {"ZeroSpacing", with("spacing = 0.002", "spacing = 0"), "model.spacing", 2, {"> 0"}},
       {"MissingSpacing", with("spacing = 0.002\n", ""), "model.spacing", 1, {"missing"}},
       {"NoShapes", "[model]\nspacing = 0.002\n[materials.adipose]\nE = 3000.0\n", "model.shape", 1,
@@ -331,8 +332,21 @@ std::vector<ErrorCase> error_cases() {
        "model.shape[0].max", 6, {"exceed"}},
       {"LabelWithoutMaterial", with("label = \"adipose\"", "label = \"glandular\""),
        "model.shape[0].label", 3, {"glandular"}},
-      {"ImageNotSupported", with("spacing = 0.002", "spacing = 0.002\nimage = \"ct.nii.gz\""),
-       "model.image", 3, {"not supported yet", "analytic shapes only"}},
+      {"ImageAndShapes", with("spacing = 0.002", "spacing = 0.002\nimage = \"ct.nii.gz\""),
+       "model.image", 3, {"not both"}},
+      {"ImageWithoutClassification", "[model]\nimage = \"ct.nii.gz\"\n", "model.image", 2,
+       {"labels", "hu_class"}},
+      {"LabelTableKeyNotANumber",
+       "[model]\nimage = \"ct.nii.gz\"\nlabels = \"l.nii.gz\"\n[model.label_table]\nfat = \"adipose\"\n",
+       "model.label_table.fat", 5, {"label values"}},
+      {"HuClassMaxBelowMin",
+       "[model]\nimage = \"ct.nii.gz\"\n[[model.hu_class]]\ntissue = \"adipose\"\nmin = 0\nmax = -100\n",
+       "model.hu_class[0].max", 6, {"greater than min"}},
+      {"RoiMinWithoutMax",
+       "[model]\nimage = \"ct.nii.gz\"\nroi_min = [0, 0, 0]\n[[model.hu_class]]\ntissue = \"adipose\"\nmin = -200\nmax = 0\n",
+       "model.roi_max", 1, {"go together"}},
+      {"ShapeModelWithImageKey", with("spacing = 0.002", "spacing = 0.002\nkeep = [\"adipose\"]"),
+       "model.keep", 3, {"image models only"}},
       {"BothVectorAndPosture", kBase + "[gravity]\nvector = [0, 0, -9.81]\nposture = \"prone\"\n",
        "gravity.posture", 12, {"not both"}},
       {"UnknownPosture", kBase + "[gravity]\nposture = \"sideways\"\n", "gravity.posture", 11,
@@ -449,6 +463,32 @@ TEST(SampleScenes, EveryDataSampleSceneParses) {
       ADD_FAILURE() << e.what();
     }
   }
+}
+
+}  // namespace
+}  // namespace vb
+
+namespace vb {
+namespace {
+
+TEST(SceneFileImage, ReadsAnImageModelWithDefaultsAndRelativePaths) {
+  const std::string dir = ::testing::TempDir() + "/voxbreast_scene_image";
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/scene.toml";
+  std::ofstream(path) << "[model]\nimage = \"ct.nii.gz\"\nlabels = \"labels.nii.gz\"\nkeep = [\"adipose\", \"bone\"]\n"
+                         "roi_min = [-0.1, -0.1, -0.1]\nroi_max = [0.1, 0.0, 0.1]\n"
+                         "[model.label_table]\n2 = \"adipose\"\n5 = \"bone\"\n"
+                         "[materials.adipose]\nE = 4000.0\n";
+  const Scene s = parse_scene_file(path);
+  EXPECT_TRUE(s.model.from_image());
+  EXPECT_EQ(s.model.image_path, (std::filesystem::path(dir) / "ct.nii.gz").lexically_normal().string());
+  EXPECT_EQ(s.model.label_table.at(5), "bone");
+  ASSERT_TRUE(s.model.roi_m.has_value());
+  EXPECT_EQ(s.model.roi_m->second.y(), 0.0);
+  EXPECT_EQ(s.materials.at("adipose").youngs_modulus_pa, 4000.0);  // override
+  EXPECT_EQ(s.materials.at("adipose").density_kg_m3, 950.0);       // default kept
+  EXPECT_TRUE(s.materials.at("bone").rigid);                        // default material filled in
+  EXPECT_EQ(s.model.spacing_m, 0.0);                                // image's own spacing
 }
 
 }  // namespace

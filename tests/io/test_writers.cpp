@@ -121,8 +121,8 @@ Scene tiny_scene() {
   Scene s;
   s.source_path = "scenes/tiny.toml";
   s.source_text = "[model]\nspacing = 0.002\n# ünïcode survives\n";
-  s.materials["adipose"] = {"adipose", "linear", 3000.0, 950.0, 3};
-  s.materials["glandular"] = {"glandular", "neo-hookean", 9000.0, 1040.0, 7};
+  s.materials["adipose"] = {"adipose", "linear", 3000.0, 950.0, false, 3};
+  s.materials["glandular"] = {"glandular", "neo-hookean", 9000.0, 1040.0, false, 7};
   return s;
 }
 

@@ -1,0 +1,799 @@
+#include "io/dicom_io.hpp"
+
+#include <dcmtk/config/osconfig.h>  // DCMTK: must come before its other headers
+#include <dcmtk/dcmdata/dcdeftag.h>
+#include <dcmtk/dcmdata/dcdict.h>
+#include <dcmtk/dcmdata/dcfilefo.h>
+#include <dcmtk/dcmdata/dcmetinf.h>
+#include <dcmtk/dcmdata/dcrledrg.h>
+#include <dcmtk/dcmdata/dcuid.h>
+#include <dcmtk/dcmdata/dcxfer.h>
+#include <dcmtk/dcmjpeg/djdecode.h>
+#include <dcmtk/dcmjpls/djdecode.h>
+#include <dcmtk/oflog/oflog.h>
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <sstream>
+
+#include "engine/error.hpp"
+#include "voxbreast/config.hpp"
+
+namespace fs = std::filesystem;
+
+namespace vb {
+namespace {
+
+// ---- DCMTK set-up ----------------------------------------------------------------------------
+
+/// Once per process: silence DCMTK's logger (library code must not write to stderr; errors reach
+/// the caller as vb::Error) and register the JPEG, JPEG-LS and RLE decoders.
+void init_dcmtk() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    OFLog::getLogger("dcmtk").setLogLevel(OFLogger::OFF_LOG_LEVEL);
+    DJDecoderRegistration::registerCodecs();
+    DJLSDecoderRegistration::registerCodecs();
+    DcmRLEDecoderRegistration::registerCodecs();
+  });
+  require(dcmDataDict.isDictionaryLoaded(), "the DICOM data dictionary is not loaded", {},
+          "install DCMTK's dictionary (dicom.dic) or point DCMDICTPATH at it");
+}
+
+// ---- attributes carried from a source series to derived series --------------------------------
+
+/// Patient and study attributes (plus the character set they are encoded in).
+const std::array<DcmTagKey, 13> kCarriedTags = {
+    DCM_SpecificCharacterSet, DCM_PatientName,      DCM_PatientID,
+    DCM_PatientBirthDate,     DCM_PatientSex,       DCM_StudyInstanceUID,
+    DCM_StudyID,              DCM_StudyDate,        DCM_StudyTime,
+    DCM_AccessionNumber,      DCM_ReferringPhysicianName, DCM_StudyDescription,
+    DCM_FrameOfReferenceUID};
+
+constexpr const char* kSourceSeriesKey = "source_series_uid";
+constexpr const char* kCorruptFileHint = "the file may be truncated or corrupt; remove or replace it";
+
+/// "gggg,eeee" in upper-case hex, as the standard prints tags.
+std::string tag_key_text(const DcmTagKey& key) {
+  char text[10];
+  std::snprintf(text, sizeof text, "%04X,%04X", unsigned(key.getGroup()),
+                unsigned(key.getElement()));
+  return text;
+}
+
+std::optional<DcmTagKey> parse_tag_key(const std::string& text) {
+  unsigned group = 0, element = 0;
+  char tail = 0;
+  if (text.size() != 9 || std::sscanf(text.c_str(), "%4x,%4x%c", &group, &element, &tail) != 2)
+    return std::nullopt;
+  return DcmTagKey(Uint16(group), Uint16(element));
+}
+
+// ---- reading attributes ----------------------------------------------------------------------
+
+/// All values joined by '\', "" when absent.
+std::string get_text(DcmItem& item, const DcmTagKey& key) {
+  OFString value;
+  return item.findAndGetOFStringArray(key, value).good() ? std::string(value.c_str()) : "";
+}
+
+std::optional<double> get_number(DcmItem& item, const DcmTagKey& key, unsigned long pos = 0) {
+  Float64 value = 0;
+  if (item.findAndGetFloat64(key, value, pos).bad() || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+std::string tag_name(const DcmTagKey& key) {
+  return DcmTag(key).getTagName() + std::string(" (") + tag_key_text(key) + ")";
+}
+
+/// `count` numbers of a required attribute; throws naming the file when missing or malformed.
+template <int count>
+Eigen::Matrix<double, count, 1> require_numbers(DcmItem& item, const DcmTagKey& key,
+                                                const std::string& path) {
+  Eigen::Matrix<double, count, 1> values;
+  for (int n = 0; n < count; ++n) {
+    const auto value = get_number(item, key, unsigned(n));
+    require(value.has_value(),
+            "missing or malformed " + tag_name(key) + " (needs " + std::to_string(count) +
+                " numbers)",
+            path);
+    values[n] = *value;
+  }
+  return values;
+}
+
+Uint16 get_uint16(DcmItem& item, const DcmTagKey& key, Uint16 fallback) {
+  Uint16 value = fallback;
+  return item.findAndGetUint16(key, value).good() ? value : fallback;
+}
+
+// ---- scanning a folder -----------------------------------------------------------------------
+
+/// A DICOM file whose attributes up to (not including) the pixel data are loaded.
+struct DicomHeader {
+  std::string path;
+  std::unique_ptr<DcmFileFormat> file;
+  DcmDataset& data() const { return *file->getDataset(); }
+  std::string series_uid() const { return get_text(data(), DCM_SeriesInstanceUID); }
+};
+
+enum class FileKind { part10, bare_dataset, other };
+
+/// Part 10 files carry "DICM" after a 128-byte preamble; files without it are tried as bare
+/// datasets only when they start with a group 0002 or 0008 tag, so arbitrary files are never parsed.
+FileKind sniff(const std::string& path) {
+  std::array<char, 132> head{};
+  std::ifstream in(path, std::ios::binary);
+  in.read(head.data(), head.size());
+  const auto got = in.gcount();
+  if (got == 132 && std::string(&head[128], 4) == "DICM") return FileKind::part10;
+  const bool dicom_group_first = got >= 8 && (head[0] == 0x02 || head[0] == 0x08) && head[1] == 0;
+  return dicom_group_first ? FileKind::bare_dataset : FileKind::other;
+}
+
+/// The header of a DICOM file that belongs to a series; nullopt for other files.
+std::optional<DicomHeader> load_header(const std::string& path) {
+  const FileKind kind = sniff(path);
+  if (kind == FileKind::other) return std::nullopt;
+  auto file = std::make_unique<DcmFileFormat>();
+  const OFCondition status =
+      file->loadFileUntilTag(path.c_str(), EXS_Unknown, EGL_noChange, DCM_MaxReadLength,
+                             kind == FileKind::part10 ? ERM_autoDetect : ERM_dataset,
+                             DCM_PixelData);
+  if (status.bad()) {
+    if (kind == FileKind::bare_dataset) return std::nullopt;  // a guess that did not pan out
+    throw Error(std::string("cannot parse DICOM file: ") + status.text(), path,
+                kCorruptFileHint);
+  }
+  DicomHeader header{path, std::move(file)};
+  if (!header.series_uid().empty()) return header;
+  // DCMTK accepts a file cut between two attributes, so a missing series UID may mean truncation;
+  // only a DICOMDIR is a Part 10 file outside any series.
+  const bool dicomdir = get_text(*header.file->getMetaInfo(), DCM_MediaStorageSOPClassUID) ==
+                        UID_MediaStorageDirectoryStorage;
+  require(kind == FileKind::bare_dataset || dicomdir,
+          "DICOM file without SeriesInstanceUID (0020,000E)", path,
+          kCorruptFileHint);
+  return std::nullopt;
+}
+
+std::vector<DicomHeader> scan_folder(const std::string& dir) {
+  init_dcmtk();
+  std::error_code ec;
+  require(fs::is_directory(dir, ec), "not a folder", dir, "give the folder of a DICOM series");
+  std::vector<std::string> paths;
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (entry.is_regular_file()) paths.push_back(entry.path().string());
+  require(!ec, "cannot list folder: " + ec.message(), dir);
+  std::sort(paths.begin(), paths.end());  // deterministic order of files and errors
+
+  std::vector<DicomHeader> headers;
+  for (const auto& path : paths)
+    if (auto header = load_header(path)) headers.push_back(std::move(*header));
+  require(!headers.empty(), "no DICOM files in the folder", dir,
+          "give the folder that holds the series' files");
+  return headers;
+}
+
+using SeriesMap = std::map<std::string, std::vector<const DicomHeader*>>;
+
+SeriesMap group_by_series(const std::vector<DicomHeader>& headers) {
+  SeriesMap series;
+  for (const auto& header : headers) series[header.series_uid()].push_back(&header);
+  return series;
+}
+
+DicomSeriesInfo describe(const std::string& uid, const std::vector<const DicomHeader*>& files) {
+  DcmDataset& first = files.front()->data();
+  return {uid, get_text(first, DCM_Modality), get_text(first, DCM_SeriesDescription),
+          int(files.size())};
+}
+
+std::string series_listing(const SeriesMap& series) {
+  std::string text;
+  for (const auto& [uid, files] : series) {
+    const DicomSeriesInfo info = describe(uid, files);
+    text += "\n  " + info.series_uid + "  " + info.modality + "  \"" + info.description + "\"  " +
+            std::to_string(info.files) + " files";
+  }
+  return text;
+}
+
+const std::vector<const DicomHeader*>& choose_series(const SeriesMap& series,
+                                                     const std::string& uid,
+                                                     const std::string& dir) {
+  if (uid.empty()) {
+    require(series.size() == 1,
+            "the folder holds " + std::to_string(series.size()) + " series:" +
+                series_listing(series),
+            dir, "choose one with --series UID");
+    return series.begin()->second;
+  }
+  const auto found = series.find(uid);
+  require(found != series.end(), "no series " + uid + " in the folder; it holds:" +
+                                     series_listing(series),
+          dir, "choose one of the listed UIDs with --series UID");
+  return found->second;
+}
+
+// ---- slice geometry --------------------------------------------------------------------------
+
+/// Where one slice lies (mm, LPS) and what its pixel grid is.
+struct Slice {
+  std::string path;
+  Eigen::Vector3d position_mm;     ///< ImagePositionPatient: centre of the first pixel
+  Eigen::Vector3d row_direction;   ///< along a row: the direction of increasing column index
+  Eigen::Vector3d column_direction;
+  double row_spacing_mm = 0;       ///< PixelSpacing[0]: between rows, i.e. along a column
+  double column_spacing_mm = 0;    ///< PixelSpacing[1]: between columns, i.e. along a row
+  int rows = 0, columns = 0;
+  double along_normal_mm = 0;      ///< position · slice normal, the sort key
+};
+
+Slice read_slice_geometry(const DicomHeader& header) {
+  DcmDataset& data = header.data();
+  const Eigen::Matrix<double, 6, 1> cosines =
+      require_numbers<6>(data, DCM_ImageOrientationPatient, header.path);
+  const Eigen::Vector2d pixel_spacing = require_numbers<2>(data, DCM_PixelSpacing, header.path);
+  Slice slice{header.path,
+              require_numbers<3>(data, DCM_ImagePositionPatient, header.path),
+              cosines.head<3>(),
+              cosines.tail<3>(),
+              pixel_spacing[0],
+              pixel_spacing[1],
+              get_uint16(data, DCM_Rows, 0),
+              get_uint16(data, DCM_Columns, 0)};
+  require(slice.rows > 0 && slice.columns > 0, "missing Rows/Columns", header.path);
+  require(pixel_spacing.minCoeff() > 0, "PixelSpacing must be positive", header.path);
+  const bool orthonormal = std::abs(slice.row_direction.norm() - 1) < 1e-3 &&
+                           std::abs(slice.column_direction.norm() - 1) < 1e-3 &&
+                           std::abs(slice.row_direction.dot(slice.column_direction)) < 1e-3;
+  require(orthonormal, "ImageOrientationPatient is not two orthogonal unit vectors", header.path);
+  slice.row_direction.normalize();
+  slice.column_direction.normalize();
+  return slice;
+}
+
+/// All slices must share one pixel grid and orientation: anything else is not one volume.
+void check_same_grid(const std::vector<Slice>& slices) {
+  const Slice& first = slices.front();
+  auto close = [](double a, double b) { return std::abs(a - b) <= 1e-4 * std::max(1.0, std::abs(a)); };
+  for (const Slice& s : slices) {
+    require(s.rows == first.rows && s.columns == first.columns,
+            "mixed image sizes in one series: " + std::to_string(s.columns) + "×" +
+                std::to_string(s.rows) + " vs " + std::to_string(first.columns) + "×" +
+                std::to_string(first.rows) + " in " + first.path,
+            s.path, "the series is not one volume; choose another series");
+    require(close(s.row_spacing_mm, first.row_spacing_mm) &&
+                close(s.column_spacing_mm, first.column_spacing_mm),
+            "mixed PixelSpacing in one series (differs from " + first.path + ")", s.path,
+            "the series is not one volume; choose another series");
+    const double turn = std::max((s.row_direction - first.row_direction).norm(),
+                                 (s.column_direction - first.column_direction).norm());
+    require(turn < 1e-4, "mixed ImageOrientationPatient in one series (differs from " +
+                             first.path + "; a localizer mixed in?)",
+            s.path, "the series is not one volume; choose another series");
+  }
+}
+
+std::string mm_text(double mm) {
+  std::ostringstream text;
+  text.precision(6);
+  text << mm << " mm";
+  return text.str();
+}
+
+double median(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+/// The k spacing of a sorted stack (mm). Duplicates are always errors; uneven gaps are errors
+/// unless `allow_gaps`, then warnings and the median gap is used.
+double stack_spacing_mm(const std::vector<Slice>& sorted, bool allow_gaps,
+                        std::vector<std::string>& warnings) {
+  std::vector<double> gaps;
+  for (std::size_t n = 1; n < sorted.size(); ++n) {
+    const double gap = sorted[n].along_normal_mm - sorted[n - 1].along_normal_mm;
+    require(gap > 1e-3, "duplicate slice position " + mm_text(sorted[n].along_normal_mm) +
+                            " along the normal, shared with " + sorted[n - 1].path,
+            sorted[n].path, "remove the duplicate file or choose another series");
+    gaps.push_back(gap);
+  }
+  const double typical = median(gaps);
+  for (std::size_t n = 0; n < gaps.size(); ++n) {
+    if (std::abs(gaps[n] - typical) <= 0.01 * typical) continue;
+    const std::string what = "uneven slice spacing: gap of " + mm_text(gaps[n]) +
+                             " between slices " + std::to_string(n) + " and " +
+                             std::to_string(n + 1) + " (" + sorted[n].path + ", " +
+                             sorted[n + 1].path + "); the median gap is " + mm_text(typical);
+    require(allow_gaps, what, {}, "a slice may be missing; allow gaps to read it anyway");
+    warnings.push_back(what + "; read with the median gap, so slices beyond it are misplaced by " +
+                       mm_text(gaps[n] - typical));
+  }
+  return typical;
+}
+
+/// A single slice has no neighbour to measure: take its declared spacing or thickness.
+double single_slice_spacing_mm(const DicomHeader& header) {
+  for (const DcmTagKey& key : {DCM_SpacingBetweenSlices, DCM_SliceThickness})
+    if (const auto value = get_number(header.data(), key); value && *value > 0) return *value;
+  throw Error("a single slice without SpacingBetweenSlices or SliceThickness has no thickness",
+              header.path, "add SliceThickness (0018,0050) to the file");
+}
+
+/// Gantry-tilted (sheared) stacks step sideways from slice to slice; an orthogonal affine would
+/// misplace them, so they are refused.
+void check_stacked_along_normal(const std::vector<Slice>& sorted, const Eigen::Vector3d& normal) {
+  const Slice& first = sorted.front();
+  const double tolerance = 0.1 * std::min(first.row_spacing_mm, first.column_spacing_mm);
+  for (const Slice& s : sorted) {
+    const Eigen::Vector3d step = s.position_mm - first.position_mm;
+    const double sideways = (step - step.dot(normal) * normal).norm();
+    require(sideways <= tolerance,
+            "slices are not stacked along the slice normal (offset " + mm_text(sideways) +
+                " sideways from " + first.path + "; gantry tilt?)",
+            s.path, "resample the series onto an orthogonal grid first");
+  }
+}
+
+struct StackGeometry {
+  std::vector<const DicomHeader*> files;  ///< sorted along the slice normal
+  Eigen::Matrix4d affine_lps_m = Eigen::Matrix4d::Identity();
+  int rows = 0, columns = 0;
+};
+
+StackGeometry stack_geometry(const std::vector<const DicomHeader*>& files, bool allow_gaps,
+                             std::vector<std::string>& warnings) {
+  std::vector<Slice> slices;
+  for (const DicomHeader* header : files) slices.push_back(read_slice_geometry(*header));
+  check_same_grid(slices);
+  const Slice& first = slices.front();
+  const Eigen::Vector3d normal = first.row_direction.cross(first.column_direction);
+  std::vector<std::size_t> order(slices.size());
+  for (std::size_t n = 0; n < slices.size(); ++n) {
+    slices[n].along_normal_mm = slices[n].position_mm.dot(normal);
+    order[n] = n;
+  }
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return slices[a].along_normal_mm < slices[b].along_normal_mm;
+  });
+  std::vector<Slice> sorted;
+  StackGeometry stack;
+  for (std::size_t n : order) {
+    sorted.push_back(slices[n]);
+    stack.files.push_back(files[n]);
+  }
+  check_stacked_along_normal(sorted, normal);
+  const double spacing_mm = sorted.size() > 1 ? stack_spacing_mm(sorted, allow_gaps, warnings)
+                                              : single_slice_spacing_mm(*stack.files.front());
+
+  constexpr double m_per_mm = 1e-3;
+  stack.affine_lps_m.block<3, 1>(0, 0) = first.row_direction * first.column_spacing_mm * m_per_mm;
+  stack.affine_lps_m.block<3, 1>(0, 1) = first.column_direction * first.row_spacing_mm * m_per_mm;
+  stack.affine_lps_m.block<3, 1>(0, 2) = normal * spacing_mm * m_per_mm;
+  stack.affine_lps_m.block<3, 1>(0, 3) = sorted.front().position_mm * m_per_mm;
+  stack.rows = first.rows;
+  stack.columns = first.columns;
+  return stack;
+}
+
+// ---- pixel data ------------------------------------------------------------------------------
+
+/// Brings encapsulated (compressed) pixel data to native form with the registered decoders.
+void decompress(DcmDataset& data, const std::string& path) {
+  const DcmXfer syntax(data.getOriginalXfer());
+  if (!syntax.isEncapsulated()) return;
+  const bool decoded = data.chooseRepresentation(EXS_LittleEndianExplicit, nullptr).good() &&
+                       data.canWriteXfer(EXS_LittleEndianExplicit);
+  require(decoded,
+          std::string("cannot decode transfer syntax ") + syntax.getXferName() + " (" +
+              syntax.getXferID() + ")",
+          path,
+          "supported: uncompressed, deflated, JPEG baseline/extended/lossless, JPEG-LS, RLE; "
+          "convert the series first (e.g. gdcmconv --raw)");
+}
+
+/// Stored value of a pixel: the low `bits_stored` bits, two's complement when signed.
+std::int64_t stored_value(std::uint32_t raw, int bits_stored, bool is_signed) {
+  const std::uint32_t mask = (std::uint32_t(1) << bits_stored) - 1;  // bits_stored ≤ 16
+  const std::int64_t value = raw & mask;
+  const bool negative = is_signed && (value >> (bits_stored - 1)) != 0;
+  return negative ? value - (std::int64_t(1) << bits_stored) : value;
+}
+
+/// The native pixel array (8 or 16 bits allocated) widened to 32 bits.
+std::vector<std::uint32_t> raw_pixels(DcmDataset& data, int bits_allocated,
+                                      const std::string& path) {
+  unsigned long count = 0;
+  OFCondition status;
+  std::vector<std::uint32_t> pixels;
+  if (bits_allocated == 16) {
+    const Uint16* values = nullptr;
+    status = data.findAndGetUint16Array(DCM_PixelData, values, &count);
+    if (status.good() && values) pixels.assign(values, values + count);
+  } else {
+    const Uint8* values = nullptr;
+    status = data.findAndGetUint8Array(DCM_PixelData, values, &count);
+    if (status.good() && values) pixels.assign(values, values + count);
+  }
+  require(status.good() && !pixels.empty(), "no readable pixel data", path);
+  return pixels;
+}
+
+/// Decodes one slice's pixels into `out` (rows × columns, column index fastest) in rescaled units.
+void read_slice_pixels(const std::string& path, int rows, int columns, float* out) {
+  DcmFileFormat file;
+  const OFCondition status = file.loadFile(path.c_str());
+  require(status.good(), std::string("cannot read DICOM file: ") + status.text(), path,
+          kCorruptFileHint);
+  DcmDataset& data = *file.getDataset();
+  decompress(data, path);
+
+  const int samples = get_uint16(data, DCM_SamplesPerPixel, 1);
+  const int bits_allocated = get_uint16(data, DCM_BitsAllocated, 0);
+  const int bits_stored = get_uint16(data, DCM_BitsStored, Uint16(bits_allocated));
+  const int high_bit = get_uint16(data, DCM_HighBit, Uint16(bits_stored - 1));
+  const bool is_signed = get_uint16(data, DCM_PixelRepresentation, 0) == 1;
+  const double frames = get_number(data, DCM_NumberOfFrames).value_or(1);
+  require(samples == 1, "only greyscale images (SamplesPerPixel 1) are supported", path);
+  require(frames == 1, "multi-frame images are not supported", path,
+          "convert the series to one file per slice");
+  require((bits_allocated == 8 || bits_allocated == 16) && bits_stored >= 1 &&
+              bits_stored <= bits_allocated && high_bit == bits_stored - 1,
+          "unsupported pixel layout (BitsAllocated " + std::to_string(bits_allocated) +
+              ", BitsStored " + std::to_string(bits_stored) + ", HighBit " +
+              std::to_string(high_bit) + ")",
+          path);
+
+  const std::vector<std::uint32_t> raw = raw_pixels(data, bits_allocated, path);
+  const std::size_t count = std::size_t(rows) * std::size_t(columns);
+  require(raw.size() >= count,
+          "pixel data too short: " + std::to_string(raw.size()) + " of " + std::to_string(count) +
+              " pixels",
+          path, "the file may be truncated");
+  const double slope = get_number(data, DCM_RescaleSlope).value_or(1.0);
+  const double intercept = get_number(data, DCM_RescaleIntercept).value_or(0.0);
+  for (std::size_t n = 0; n < count; ++n)
+    out[n] = float(double(stored_value(raw[n], bits_stored, is_signed)) * slope + intercept);
+}
+
+void carry_tags(DcmDataset& data, ImageVolume& volume) {
+  for (const DcmTagKey& key : kCarriedTags) {
+    OFString value;
+    if (data.findAndGetOFStringArray(key, value).good())
+      volume.dicom_tags[tag_key_text(key)] = value.c_str();
+  }
+  volume.dicom_tags[kSourceSeriesKey] = get_text(data, DCM_SeriesInstanceUID);
+}
+
+// ---- writing ---------------------------------------------------------------------------------
+
+/// Slice grid of a volume in DICOM terms (mm, LPS).
+struct WriteGeometry {
+  Eigen::Vector3d row_direction, column_direction;  ///< voxel axes i and j, unit
+  double column_spacing_mm = 0, row_spacing_mm = 0;  ///< |axis i|, |axis j|
+  Eigen::Vector3d origin_mm, slice_step_mm;          ///< voxel (0,0,0), axis k
+};
+
+WriteGeometry write_geometry(const ImageVolume& ct, const std::string& dir) {
+  const Eigen::Matrix3d axes_mm = ct.affine_lps_m.topLeftCorner<3, 3>() * 1e3;
+  WriteGeometry g;
+  g.column_spacing_mm = axes_mm.col(0).norm();
+  g.row_spacing_mm = axes_mm.col(1).norm();
+  const double slice_spacing_mm = axes_mm.col(2).norm();
+  require(g.column_spacing_mm > 0 && g.row_spacing_mm > 0 && slice_spacing_mm > 0,
+          "the volume's affine has a zero-length axis", dir);
+  g.row_direction = axes_mm.col(0) / g.column_spacing_mm;
+  g.column_direction = axes_mm.col(1) / g.row_spacing_mm;
+  const Eigen::Vector3d k_direction = axes_mm.col(2) / slice_spacing_mm;
+  const double shear = std::max({std::abs(g.row_direction.dot(g.column_direction)),
+                                 std::abs(g.row_direction.dot(k_direction)),
+                                 std::abs(g.column_direction.dot(k_direction))});
+  require(shear < 1e-4, "the volume's affine is sheared (voxel axes not perpendicular)", dir,
+          "DICOM CT slices need perpendicular axes; resample the volume first");
+  g.origin_mm = ct.affine_lps_m.topRightCorner<3, 1>() * 1e3;
+  g.slice_step_mm = axes_mm.col(2);
+  return g;
+}
+
+/// Stored = round((HU − intercept) / slope) in int16.
+struct Rescale {
+  double slope = 1, intercept = -1024;
+};
+
+/// Slope 1 / intercept −1024 (the CT convention) when the rounded HU fit int16 that way,
+/// else a slope spreading [min, max] over the whole int16 range.
+Rescale choose_rescale(const std::vector<float>& values, const std::string& dir) {
+  const auto [low, high] = std::minmax_element(values.begin(), values.end());
+  const auto finite = std::find_if(values.begin(), values.end(),
+                                   [](float v) { return !std::isfinite(v); });
+  require(finite == values.end(),
+          "the volume holds a non-finite value at index " +
+              std::to_string(finite - values.begin()),
+          dir);
+  Rescale rescale;
+  const double stored_low = std::round(double(*low)) - rescale.intercept;
+  const double stored_high = std::round(double(*high)) - rescale.intercept;
+  if (stored_low >= INT16_MIN && stored_high <= INT16_MAX) return rescale;
+  rescale.slope = (double(*high) - double(*low)) / (double(INT16_MAX) - double(INT16_MIN));
+  rescale.intercept = double(*low) - double(INT16_MIN) * rescale.slope;
+  return rescale;
+}
+
+std::vector<Uint16> stored_pixels(const float* hu, std::size_t count, const Rescale& rescale) {
+  std::vector<Uint16> stored(count);
+  for (std::size_t n = 0; n < count; ++n) {
+    const double value = std::round((double(hu[n]) - rescale.intercept) / rescale.slope);
+    stored[n] = Uint16(std::int16_t(std::clamp(value, double(INT16_MIN), double(INT16_MAX))));
+  }
+  return stored;
+}
+
+/// Decimal string (DS) of at most 16 characters, as precise as fits.
+std::string ds_text(double value) {
+  if (std::abs(value) < 1e-12) value = 0;  // avoid "1e-17"-style noise from rotations
+  char text[32];
+  for (int digits = 15; digits > 1; --digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, value);
+    if (std::string(text).size() <= 16) break;
+  }
+  return text;
+}
+
+template <class Vector>
+std::string ds_list(const Vector& values) {
+  std::string text;
+  for (int n = 0; n < int(values.size()); ++n) text += (n ? "\\" : "") + ds_text(values[n]);
+  return text;
+}
+
+/// The UID root is DCMTK's (OFFIS-registered) site root; replace it here with your own
+/// registered root if your site requires one.
+std::string new_uid(const char* root) {
+  char uid[100];
+  return dcmGenerateUniqueIdentifier(uid, root);
+}
+
+/// Attributes shared by every slice of the written series.
+struct SeriesAttributes {
+  std::map<std::string, std::string> carried;  ///< "gggg,eeee" → value
+  std::string series_uid, series_description, derivation;
+  Rescale rescale;
+  WriteGeometry geometry;
+};
+
+std::map<std::string, std::string> carried_attributes(const ImageVolume& ct) {
+  std::map<std::string, std::string> carried;
+  for (const auto& [key, value] : ct.dicom_tags) {
+    const auto tag = parse_tag_key(key);
+    if (tag && std::find(kCarriedTags.begin(), kCarriedTags.end(), *tag) != kCarriedTags.end())
+      carried[tag_key_text(*tag)] = value;
+  }
+  // Without a source study (NIfTI, phantom) the series starts its own study and frame.
+  carried.try_emplace(tag_key_text(DCM_StudyInstanceUID), new_uid(SITE_STUDY_UID_ROOT));
+  carried.try_emplace(tag_key_text(DCM_FrameOfReferenceUID), new_uid(SITE_INSTANCE_UID_ROOT));
+  carried.try_emplace(tag_key_text(DCM_PatientName), "VoxBreast^Phantom");
+  carried.try_emplace(tag_key_text(DCM_PatientID), "VOXBREAST");
+  return carried;
+}
+
+class DatasetWriter {
+ public:
+  DatasetWriter(DcmDataset& data, const std::string& path) : data_(data), path_(path) {}
+  void text(const DcmTagKey& key, const std::string& value) {
+    check(data_.putAndInsertOFStringArray(key, value.c_str()), key);
+  }
+  void number(const DcmTagKey& key, Uint16 value) {
+    check(data_.putAndInsertUint16(key, value), key);
+  }
+  void words(const DcmTagKey& key, const std::vector<Uint16>& values) {
+    check(data_.putAndInsertUint16Array(key, values.data(), values.size()), key);
+  }
+
+ private:
+  void check(const OFCondition& status, const DcmTagKey& key) {
+    require(status.good(), "cannot set " + tag_name(key) + ": " + status.text(), path_);
+  }
+  DcmDataset& data_;
+  const std::string& path_;
+};
+
+void write_slice(const std::string& path, const SeriesAttributes& series, const ImageVolume& ct,
+                 int k) {
+  DcmFileFormat file;
+  DatasetWriter put(*file.getDataset(), path);
+  for (const auto& [key, value] : series.carried) put.text(*parse_tag_key(key), value);
+  // Type 2 attributes: present even when empty.
+  for (const DcmTagKey& key : {DCM_PatientBirthDate, DCM_PatientSex, DCM_StudyDate, DCM_StudyTime,
+                               DCM_ReferringPhysicianName, DCM_StudyID, DCM_AccessionNumber})
+    if (!series.carried.count(tag_key_text(key))) put.text(key, "");
+
+  put.text(DCM_SOPClassUID, UID_CTImageStorage);
+  put.text(DCM_SOPInstanceUID, new_uid(SITE_INSTANCE_UID_ROOT));
+  put.text(DCM_SeriesInstanceUID, series.series_uid);
+  put.text(DCM_Modality, "CT");
+  put.text(DCM_SeriesNumber, "9000");
+  put.text(DCM_SeriesDescription, series.series_description);
+  put.text(DCM_ImageType, "DERIVED\\SECONDARY");
+  put.text(DCM_DerivationDescription, series.derivation);
+  put.text(DCM_Manufacturer, "VoxBreast");
+  put.text(DCM_SoftwareVersions, config::version);
+  put.text(DCM_PositionReferenceIndicator, "");
+  put.text(DCM_KVP, "");
+  put.text(DCM_AcquisitionNumber, "");
+  put.text(DCM_InstanceNumber, std::to_string(k + 1));
+
+  const WriteGeometry& g = series.geometry;
+  const Eigen::Vector3d position = g.origin_mm + double(k) * g.slice_step_mm;
+  Eigen::Matrix<double, 6, 1> cosines;
+  cosines << g.row_direction, g.column_direction;
+  put.text(DCM_ImagePositionPatient, ds_list(position));
+  put.text(DCM_ImageOrientationPatient, ds_list(cosines));
+  put.text(DCM_PixelSpacing, ds_list(Eigen::Vector2d(g.row_spacing_mm, g.column_spacing_mm)));
+  put.text(DCM_SliceThickness, ds_text(g.slice_step_mm.norm()));
+  put.text(DCM_SpacingBetweenSlices, ds_text(g.slice_step_mm.norm()));
+  put.text(DCM_SliceLocation,
+           ds_text(position.dot(g.row_direction.cross(g.column_direction))));
+
+  put.number(DCM_SamplesPerPixel, 1);
+  put.text(DCM_PhotometricInterpretation, "MONOCHROME2");
+  put.number(DCM_Rows, Uint16(ct.dims[1]));
+  put.number(DCM_Columns, Uint16(ct.dims[0]));
+  put.number(DCM_BitsAllocated, 16);
+  put.number(DCM_BitsStored, 16);
+  put.number(DCM_HighBit, 15);
+  put.number(DCM_PixelRepresentation, 1);
+  put.text(DCM_RescaleIntercept, ds_text(series.rescale.intercept));
+  put.text(DCM_RescaleSlope, ds_text(series.rescale.slope));
+  put.text(DCM_RescaleType, "HU");
+  const std::size_t slice_voxels = std::size_t(ct.dims[0]) * std::size_t(ct.dims[1]);
+  put.words(DCM_PixelData, stored_pixels(&ct.values[ct.linear_index(0, 0, k)], slice_voxels,
+                                         series.rescale));
+
+  const OFCondition status = file.saveFile(path.c_str(), EXS_LittleEndianExplicit);
+  require(status.good(), std::string("cannot write DICOM file: ") + status.text(), path);
+}
+
+/// A hidden sibling folder that disappears unless it is renamed into place.
+class StagingFolder {
+ public:
+  explicit StagingFolder(const fs::path& final_dir) : final_(final_dir) {
+    static std::atomic<unsigned long> counter{0};
+    path_ = final_.parent_path() / ("." + final_.filename().string() + ".tmp-" +
+                                    std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    std::error_code ec;
+    fs::create_directories(path_, ec);
+    require(!ec, "cannot create folder: " + ec.message(), path_.string());
+  }
+  ~StagingFolder() {
+    if (committed_) return;
+    std::error_code ignored;  // best effort: a destructor must not throw
+    fs::remove_all(path_, ignored);
+  }
+  StagingFolder(const StagingFolder&) = delete;
+  StagingFolder& operator=(const StagingFolder&) = delete;
+
+  const fs::path& path() const { return path_; }
+  /// Renames onto the final folder, which POSIX allows only while that one is absent or empty.
+  void commit() {
+    std::error_code ec;
+    fs::rename(path_, final_, ec);
+    require(!ec, "cannot rename '" + path_.string() + "' into place: " + ec.message(),
+            final_.string(), "the output folder must not exist or be empty");
+    committed_ = true;
+  }
+
+ private:
+  fs::path final_, path_;
+  bool committed_ = false;
+};
+
+fs::path clean_output_path(const std::string& dir) {
+  fs::path path = fs::absolute(fs::path(dir)).lexically_normal();
+  if (path.filename().empty()) path = path.parent_path();  // "out/" → "out"
+  std::error_code ec;
+  const bool occupied = fs::exists(path, ec) && !(fs::is_directory(path, ec) &&
+                                                  fs::is_empty(path, ec));
+  require(!occupied, "the output folder exists and is not empty", dir,
+          "choose a new folder; a DICOM series is never written over existing files");
+  fs::create_directories(path.parent_path(), ec);
+  require(!ec, "cannot create folder: " + ec.message(), path.parent_path().string());
+  return path;
+}
+
+void check_writable(const ImageVolume& ct, const std::string& dir) {
+  require(ct.dims[0] > 0 && ct.dims[1] > 0 && ct.dims[2] > 0, "the volume is empty", dir);
+  require(ct.dims[0] <= 65535 && ct.dims[1] <= 65535,
+          "a slice is too large for DICOM (more than 65535 rows or columns)", dir);
+  require(ct.values.size() == ct.voxel_count(),
+          "the volume's values do not match its dims (" + std::to_string(ct.values.size()) +
+              " values for " + std::to_string(ct.voxel_count()) + " voxels)",
+          dir);
+}
+
+std::string slice_file_name(int k) {
+  char name[32];
+  std::snprintf(name, sizeof name, "CT%05d.dcm", k + 1);
+  return name;
+}
+
+}  // namespace
+
+std::vector<DicomSeriesInfo> list_dicom_series(const std::string& dir) {
+  const std::vector<DicomHeader> headers = scan_folder(dir);
+  std::vector<DicomSeriesInfo> infos;
+  for (const auto& [uid, files] : group_by_series(headers)) infos.push_back(describe(uid, files));
+  return infos;
+}
+
+ImageVolume read_dicom_series(const std::string& dir, const DicomReadOptions& options,
+                              std::vector<std::string>* warnings) {
+  const std::vector<DicomHeader> headers = scan_folder(dir);
+  const SeriesMap series = group_by_series(headers);
+  const auto& files = choose_series(series, options.series_uid, dir);
+
+  ImageVolume volume;
+  volume.modality = get_text(files.front()->data(), DCM_Modality);
+  require(options.accept_any_modality || volume.modality == "CT",
+          "not a CT series (modality " + (volume.modality.empty() ? "unknown" : volume.modality) +
+              ")",
+          files.front()->path, "give a CT series");
+
+  std::vector<std::string> stack_warnings;
+  const StackGeometry stack = stack_geometry(files, options.allow_gaps, stack_warnings);
+  volume.dims = {stack.columns, stack.rows, int(stack.files.size())};
+  volume.affine_lps_m = stack.affine_lps_m;
+  volume.values.resize(volume.voxel_count());
+  for (int k = 0; k < volume.dims[2]; ++k)
+    read_slice_pixels(stack.files[std::size_t(k)]->path, stack.rows, stack.columns,
+                      &volume.values[volume.linear_index(0, 0, k)]);
+  carry_tags(stack.files.front()->data(), volume);
+  if (warnings) warnings->insert(warnings->end(), stack_warnings.begin(), stack_warnings.end());
+  return volume;
+}
+
+ImageVolume read_dicom_series(const std::string& dir, const std::string& series_uid,
+                              bool allow_gaps, std::vector<std::string>* warnings) {
+  DicomReadOptions options;
+  options.series_uid = series_uid;
+  options.allow_gaps = allow_gaps;
+  return read_dicom_series(dir, options, warnings);
+}
+
+void write_dicom_series(const std::string& dir, const ImageVolume& ct,
+                        const std::string& series_description) {
+  init_dcmtk();
+  check_writable(ct, dir);
+  const fs::path final_dir = clean_output_path(dir);
+
+  SeriesAttributes series;
+  series.geometry = write_geometry(ct, dir);
+  series.rescale = choose_rescale(ct.values, dir);
+  series.carried = carried_attributes(ct);
+  series.series_uid = new_uid(SITE_SERIES_UID_ROOT);
+  series.series_description = series_description;
+  const auto source = ct.dicom_tags.find(kSourceSeriesKey);
+  series.derivation = "VoxBreast " + std::string(config::version) + " output" +
+                      (source != ct.dicom_tags.end() ? " from series " + source->second : "");
+
+  StagingFolder staging(final_dir);
+  for (int k = 0; k < ct.dims[2]; ++k)
+    write_slice((staging.path() / slice_file_name(k)).string(), series, ct, k);
+  staging.commit();
+}
+
+}  // namespace vb

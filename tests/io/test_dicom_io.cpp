@@ -1,0 +1,532 @@
+// DICOM series reading and writing, checked against independent readers: pydicom (Debian's
+// python3-pydicom and its sample files) and DCMTK's command-line tools (dcmdump, dcmodify,
+// dcmcjpeg, dcmcjpls, dcmcrle). Tests that need a missing tool or file skip with the reason.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <random>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "engine/error.hpp"
+#include "engine/image/image_volume.hpp"
+#include "io/dicom_io.hpp"
+
+namespace fs = std::filesystem;
+
+namespace vb {
+namespace {
+
+const fs::path kPydicomData = "/usr/lib/python3/dist-packages/pydicom/data/test_files";
+const char* kPython = "/usr/bin/python3";
+
+// ---- helpers: temporary folders, commands ----------------------------------------------------
+
+class TempDir {
+ public:
+  TempDir() {
+    static std::atomic<int> counter{0};
+    path_ = fs::temp_directory_path() /
+            ("vb_dicom_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const fs::path& path() const { return path_; }
+  fs::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  fs::path path_;
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  ///< stdout
+};
+
+CommandResult run_command(const std::string& command) {
+  CommandResult result;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return result;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), int(buffer.size()), pipe)) result.output += buffer.data();
+  const int status = ::pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+
+bool have_tool(const std::string& name) { return fs::exists("/usr/bin/" + name); }
+
+bool have_pydicom() {
+  return fs::exists(kPython) &&
+         run_command(std::string(kPython) + " -c 'import pydicom, numpy' 2>/dev/null").exit_code ==
+             0;
+}
+
+/// Runs a Python snippet (no single quotes in it) with the arguments; its stdout as numbers/words.
+std::vector<std::string> python_words(const std::string& script, const std::string& args) {
+  const CommandResult result =
+      run_command(std::string(kPython) + " -c '" + script + "' " + args + " 2>&1");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  std::istringstream in(result.output);
+  std::vector<std::string> words;
+  for (std::string word; in >> word;) words.push_back(word);
+  return words;
+}
+
+std::vector<fs::path> files_in(const fs::path& dir) {
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(dir)) files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+fs::path copy_folder(const fs::path& from, const fs::path& to) {
+  fs::create_directories(to);
+  for (const auto& file : files_in(from)) fs::copy_file(file, to / file.filename());
+  return to;
+}
+
+/// Runs `body` expecting a vb::Error; returns its message ("" and a failure if none was thrown).
+template <class Body>
+std::string error_of(Body&& body) {
+  try {
+    body();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected a vb::Error";
+  return {};
+}
+
+// ---- the test volume -------------------------------------------------------------------------
+
+/// An oblique (rotated about two axes), anisotropic, right-handed volume with fractional HU.
+ImageVolume oblique_volume(int slices = 6) {
+  ImageVolume v;
+  v.dims = {12, 9, slices};
+  const Eigen::Matrix3d rotation =
+      (Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()) *
+       Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
+  const Eigen::Vector3d spacing_m(0.7e-3, 0.9e-3, 2.5e-3);
+  v.affine_lps_m.topLeftCorner<3, 3>() = rotation * spacing_m.asDiagonal();
+  v.affine_lps_m.topRightCorner<3, 1>() = Eigen::Vector3d(-0.1234567, 0.0456789, 0.2101010);
+  v.values.resize(v.voxel_count());
+  for (int k = 0; k < v.dims[2]; ++k)
+    for (int j = 0; j < v.dims[1]; ++j)
+      for (int i = 0; i < v.dims[0]; ++i)
+        v.values[v.linear_index(i, j, k)] = float(-1000 + 37 * i - 11 * j + 53 * k + 0.3 * (i % 3));
+  v.modality = "CT";
+  v.dicom_tags = {{"0010,0010", "Doe^Jane"},       {"0010,0020", "P123"},
+                  {"0020,000D", "1.2.826.0.1.1"}, {"0020,0052", "1.2.826.0.1.2"},
+                  {"0008,0020", "20240102"},      {"source_series_uid", "1.2.826.0.1.3"}};
+  return v;
+}
+
+std::vector<float> rounded(const std::vector<float>& values) {
+  std::vector<float> out(values.size());
+  std::transform(values.begin(), values.end(), out.begin(),
+                 [](float v) { return std::round(v); });
+  return out;
+}
+
+void expect_same_volume(const ImageVolume& a, const ImageVolume& b) {
+  EXPECT_EQ(a.dims, b.dims);
+  EXPECT_TRUE(a.affine_lps_m.isApprox(b.affine_lps_m, 1e-12)) << a.affine_lps_m << "\n\n"
+                                                             << b.affine_lps_m;
+  EXPECT_EQ(a.values, b.values);
+}
+
+/// A written series of the oblique volume, reused by most tests.
+class DicomSeriesTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    volume_ = oblique_volume();
+    series_ = tmp_ / "series";
+    write_dicom_series(series_.string(), volume_, "oblique test");
+  }
+  TempDir tmp_;
+  ImageVolume volume_;
+  fs::path series_;
+};
+
+// ---- an external sample: pydicom's CT_small.dcm ----------------------------------------------
+
+TEST(DicomRead, CtSmallMatchesPydicom) {
+  const fs::path sample = kPydicomData / "CT_small.dcm";
+  if (!fs::exists(sample)) GTEST_SKIP() << "missing " << sample << " (python3-pydicom)";
+  if (!have_pydicom()) GTEST_SKIP() << "pydicom/numpy not importable by " << kPython;
+  TempDir tmp;
+  fs::copy_file(sample, tmp / "CT_small.dcm");
+
+  const ImageVolume v = read_dicom_series(tmp.path().string());
+  // rows cols, PixelSpacing (2), IPP (3), IOP (6), SliceThickness, mean HU, 4 HU at (row, col).
+  const std::vector<std::string> w = python_words(
+      "import sys, pydicom, numpy\n"
+      "d = pydicom.dcmread(sys.argv[1])\n"
+      "hu = d.pixel_array.astype(numpy.float64) * float(d.RescaleSlope) + "
+      "float(d.RescaleIntercept)\n"
+      "print(d.Rows, d.Columns, *d.PixelSpacing, *d.ImagePositionPatient, "
+      "*d.ImageOrientationPatient, d.SliceThickness, repr(hu.mean()), d.PatientID)\n"
+      "print(*[repr(hu[r, c]) for r, c in [(0, 0), (32, 64), (127, 127), (100, 10)]])",
+      quoted(tmp / "CT_small.dcm"));
+  ASSERT_EQ(w.size(), 20u);
+  auto num = [&](int n) { return std::stod(w[std::size_t(n)]); };
+
+  const int rows = int(num(0)), columns = int(num(1));
+  EXPECT_EQ(v.dims, (std::array<int, 3>{columns, rows, 1}));
+  const Eigen::Vector3d row_dir(num(7), num(8), num(9)), col_dir(num(10), num(11), num(12));
+  const Eigen::Vector3d ipp(num(4), num(5), num(6));
+  Eigen::Matrix4d expected = Eigen::Matrix4d::Identity();
+  expected.block<3, 1>(0, 0) = row_dir * num(3) * 1e-3;  // i: along a row, column spacing
+  expected.block<3, 1>(0, 1) = col_dir * num(2) * 1e-3;  // j: down a column, row spacing
+  expected.block<3, 1>(0, 2) = row_dir.cross(col_dir) * num(13) * 1e-3;
+  expected.block<3, 1>(0, 3) = ipp * 1e-3;
+  EXPECT_TRUE(v.affine_lps_m.isApprox(expected, 1e-9)) << v.affine_lps_m << "\n\n" << expected;
+
+  double sum = 0;
+  for (float value : v.values) sum += value;
+  EXPECT_NEAR(sum / double(v.values.size()), num(14), 1e-6);
+  const std::array<std::array<int, 2>, 4> row_col = {{{0, 0}, {32, 64}, {127, 127}, {100, 10}}};
+  for (int n = 0; n < 4; ++n)
+    EXPECT_EQ(v.values[v.linear_index(row_col[n][1], row_col[n][0], 0)], float(num(16 + n)))
+        << "row " << row_col[n][0] << " column " << row_col[n][1];
+
+  EXPECT_EQ(v.modality, "CT");
+  EXPECT_EQ(v.dicom_tags.at("0010,0020"), w[15]);
+  EXPECT_FALSE(v.dicom_tags.at("0020,000D").empty());
+  EXPECT_FALSE(v.dicom_tags.at("source_series_uid").empty());
+}
+
+/// pydicom's MR sample stored uncompressed, RLE and JPEG-LS: the codecs must give equal pixels;
+/// its JPEG 2000 copy has no decoder in DCMTK and must be refused by name.
+TEST(DicomRead, PydicomCompressedSamplesDecodeAlike) {
+  const std::vector<std::string> names = {"MR_small.dcm", "MR_small_RLE.dcm",
+                                          "MR_small_jpeg_ls_lossless.dcm",
+                                          "MR_small_jp2klossless.dcm"};
+  for (const auto& name : names)
+    if (!fs::exists(kPydicomData / name)) GTEST_SKIP() << "missing " << kPydicomData / name;
+  DicomReadOptions any;
+  any.accept_any_modality = true;
+  std::vector<ImageVolume> volumes;
+  for (std::size_t n = 0; n < 3; ++n) {
+    TempDir tmp;
+    fs::copy_file(kPydicomData / names[n], tmp / names[n]);
+    volumes.push_back(read_dicom_series(tmp.path().string(), any));
+    EXPECT_EQ(volumes.back().modality, "MR");
+  }
+  expect_same_volume(volumes[0], volumes[1]);
+  expect_same_volume(volumes[0], volumes[2]);
+
+  TempDir tmp;
+  fs::copy_file(kPydicomData / names[3], tmp / names[3]);
+  const std::string message = error_of([&] { read_dicom_series(tmp.path().string(), any); });
+  EXPECT_NE(message.find("JPEG 2000"), std::string::npos) << message;
+  EXPECT_NE(message.find(names[3]), std::string::npos) << message;
+}
+
+// ---- round trip through the writer -----------------------------------------------------------
+
+TEST_F(DicomSeriesTest, RoundTripKeepsGeometryValuesAndStudy) {
+  ASSERT_EQ(files_in(series_).size(), std::size_t(volume_.dims[2]));
+  const ImageVolume back = read_dicom_series(series_.string());
+  EXPECT_EQ(back.dims, volume_.dims);
+  EXPECT_LT((back.affine_lps_m - volume_.affine_lps_m).cwiseAbs().maxCoeff(), 1e-6)
+      << back.affine_lps_m << "\n\n" << volume_.affine_lps_m;
+  EXPECT_EQ(back.values, rounded(volume_.values));
+  EXPECT_EQ(back.modality, "CT");
+  for (const char* key : {"0010,0010", "0010,0020", "0020,000D", "0020,0052", "0008,0020"})
+    EXPECT_EQ(back.dicom_tags.at(key), volume_.dicom_tags.at(key)) << key;
+  EXPECT_NE(back.dicom_tags.at("source_series_uid"), volume_.dicom_tags.at("source_series_uid"));
+
+  const auto series = list_dicom_series(series_.string());
+  ASSERT_EQ(series.size(), 1u);
+  EXPECT_EQ(series[0].series_uid, back.dicom_tags.at("source_series_uid"));
+  EXPECT_EQ(series[0].modality, "CT");
+  EXPECT_EQ(series[0].description, "oblique test");
+  EXPECT_EQ(series[0].files, volume_.dims[2]);
+}
+
+TEST_F(DicomSeriesTest, DcmdumpReadsEveryFile) {
+  if (!have_tool("dcmdump")) GTEST_SKIP() << "dcmdump missing (Debian package dcmtk)";
+  for (const auto& file : files_in(series_))
+    EXPECT_EQ(run_command("dcmdump " + quoted(file) + " >/dev/null 2>&1").exit_code, 0) << file;
+}
+
+/// An independent reader sees new shared series UID, unique instance UIDs, the copied patient,
+/// and each slice where the affine puts it (catches a row/column mix-up the reader could mirror).
+TEST_F(DicomSeriesTest, PydicomSeesUidsPatientAndPositions) {
+  if (!have_pydicom()) GTEST_SKIP() << "pydicom/numpy not importable by " << kPython;
+  const std::vector<std::string> w = python_words(
+      "import sys, glob, pydicom\n"
+      "for f in sorted(glob.glob(sys.argv[1] + \"/*\")):\n"
+      "  d = pydicom.dcmread(f)\n"
+      "  print(d.SeriesInstanceUID, d.SOPInstanceUID, d.PatientID, d.InstanceNumber, "
+      "*d.ImagePositionPatient, *d.ImageOrientationPatient[:3], *d.PixelSpacing, "
+      "repr(float(d.pixel_array[1, 2]) * float(d.RescaleSlope) + float(d.RescaleIntercept)))",
+      quoted(series_));
+  constexpr std::size_t per_file = 13;
+  ASSERT_EQ(w.size(), per_file * std::size_t(volume_.dims[2]));
+  std::set<std::string> series_uids, instance_uids;
+  const Eigen::Vector3d row_direction = volume_.affine_lps_m.block<3, 1>(0, 0).normalized();
+  for (std::size_t f = 0; f < std::size_t(volume_.dims[2]); ++f) {
+    const auto at = [&](std::size_t n) { return w[f * per_file + n]; };
+    const auto num = [&](std::size_t n) { return std::stod(at(n)); };
+    series_uids.insert(at(0));
+    instance_uids.insert(at(1));
+    EXPECT_EQ(at(2), "P123");
+    const int k = std::stoi(at(3)) - 1;
+    const Eigen::Vector3d expected_mm = volume_.world_of_index({0, 0, double(k)}) * 1e3;
+    EXPECT_LT((Eigen::Vector3d(num(4), num(5), num(6)) - expected_mm).norm(), 1e-6) << "slice " << k;
+    EXPECT_LT((Eigen::Vector3d(num(7), num(8), num(9)) - row_direction).norm(), 1e-9);
+    EXPECT_NEAR(num(10), 0.9, 1e-12) << "PixelSpacing[0] is the row spacing (along j)";
+    EXPECT_NEAR(num(11), 0.7, 1e-12) << "PixelSpacing[1] is the column spacing (along i)";
+    EXPECT_EQ(num(12), std::round(volume_.values[volume_.linear_index(2, 1, k)]));
+  }
+  EXPECT_EQ(series_uids.size(), 1u);
+  EXPECT_NE(*series_uids.begin(), volume_.dicom_tags.at("source_series_uid"));
+  EXPECT_EQ(instance_uids.size(), std::size_t(volume_.dims[2]));
+}
+
+TEST_F(DicomSeriesTest, FileNamesDoNotMatter) {
+  const ImageVolume before = read_dicom_series(series_.string());
+  std::mt19937 random(20240611);
+  std::vector<fs::path> files = files_in(series_);
+  std::shuffle(files.begin(), files.end(), random);
+  for (std::size_t n = 0; n < files.size(); ++n)  // reversed names, and no extension
+    fs::rename(files[n], series_ / ("x" + std::to_string(files.size() - n)));
+  expect_same_volume(read_dicom_series(series_.string()), before);
+}
+
+TEST_F(DicomSeriesTest, OtherFilesInTheFolderAreSkipped) {
+  const ImageVolume before = read_dicom_series(series_.string());
+  FILE* text = std::fopen((series_ / "README.txt").c_str(), "w");
+  ASSERT_NE(text, nullptr);
+  std::fputs("not a DICOM file\n", text);
+  std::fclose(text);
+  fs::create_directory(series_ / "subfolder");
+  expect_same_volume(read_dicom_series(series_.string()), before);
+}
+
+TEST_F(DicomSeriesTest, MissingSliceIsAGapUnlessAllowed) {
+  fs::remove(files_in(series_)[2]);
+  const std::string message = error_of([&] { read_dicom_series(series_.string()); });
+  EXPECT_NE(message.find("gap of 5 mm"), std::string::npos) << message;
+  EXPECT_NE(message.find("median gap is 2.5 mm"), std::string::npos) << message;
+
+  std::vector<std::string> warnings;
+  const ImageVolume v = read_dicom_series(series_.string(), "", true, &warnings);
+  EXPECT_EQ(v.dims[2], volume_.dims[2] - 1);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("gap"), std::string::npos) << warnings[0];
+  EXPECT_NEAR(v.spacing_m()[2], 2.5e-3, 1e-9);
+}
+
+TEST_F(DicomSeriesTest, DuplicatePositionIsAnError) {
+  fs::copy_file(files_in(series_)[1], series_ / "copy.dcm");
+  const std::string message = error_of([&] { read_dicom_series(series_.string()); });
+  EXPECT_NE(message.find("duplicate slice position"), std::string::npos) << message;
+}
+
+TEST_F(DicomSeriesTest, TwoSeriesNeedAChoice) {
+  const fs::path other = tmp_ / "other";
+  write_dicom_series(other.string(), oblique_volume(3), "second");
+  const fs::path mixed = tmp_ / "mixed";
+  copy_folder(series_, mixed);
+  for (const auto& file : files_in(other)) fs::copy_file(file, mixed / ("b" + file.filename().string()));
+
+  const auto series = list_dicom_series(mixed.string());
+  ASSERT_EQ(series.size(), 2u);
+  const std::string message = error_of([&] { read_dicom_series(mixed.string()); });
+  for (const auto& s : series) {
+    EXPECT_NE(message.find(s.series_uid), std::string::npos) << message;
+    EXPECT_NE(message.find(std::to_string(s.files) + " files"), std::string::npos) << message;
+    EXPECT_NE(message.find(s.description), std::string::npos) << message;
+  }
+  EXPECT_NE(message.find("--series UID"), std::string::npos) << message;
+
+  for (const auto& s : series)
+    EXPECT_EQ(read_dicom_series(mixed.string(), s.series_uid).dims[2], s.files);
+  const std::string unknown = error_of([&] { read_dicom_series(mixed.string(), "1.2.3"); });
+  EXPECT_NE(unknown.find("no series 1.2.3"), std::string::npos) << unknown;
+}
+
+/// A file cut anywhere after its "DICM" mark, inside an attribute or between two, is an error
+/// naming it (DCMTK itself accepts cuts between attributes).
+TEST_F(DicomSeriesTest, TruncatedFileIsNamed) {
+  const fs::path victim = files_in(series_)[3];
+  const fs::path whole = tmp_ / "whole.dcm";
+  fs::copy_file(victim, whole);
+  const auto size = fs::file_size(whole);
+  for (std::uintmax_t length = 132; length < size; ++length) {
+    fs::copy_file(whole, victim, fs::copy_options::overwrite_existing);
+    fs::resize_file(victim, length);
+    const std::string message = error_of([&] { read_dicom_series(series_.string()); });
+    ASSERT_NE(message.find(victim.filename().string()), std::string::npos)
+        << "cut at " << length << " of " << size << " bytes: " << message;
+  }
+}
+
+TEST_F(DicomSeriesTest, NonCtModalityIsRefusedUnlessAccepted) {
+  if (!have_tool("dcmodify")) GTEST_SKIP() << "dcmodify missing (Debian package dcmtk)";
+  for (const auto& file : files_in(series_))
+    ASSERT_EQ(run_command("dcmodify -nb -m '(0008,0060)=MR' " + quoted(file) + " 2>&1").exit_code,
+              0);
+  const std::string message = error_of([&] { read_dicom_series(series_.string()); });
+  EXPECT_NE(message.find("not a CT series (modality MR)"), std::string::npos) << message;
+
+  DicomReadOptions any;
+  any.accept_any_modality = true;
+  const ImageVolume v = read_dicom_series(series_.string(), any);
+  EXPECT_EQ(v.modality, "MR");
+  EXPECT_EQ(v.values, rounded(volume_.values));
+}
+
+TEST_F(DicomSeriesTest, MixedOrientationIsAnError) {
+  if (!have_tool("dcmodify")) GTEST_SKIP() << "dcmodify missing (Debian package dcmtk)";
+  const fs::path odd = files_in(series_)[2];
+  ASSERT_EQ(run_command("dcmodify -nb -m '(0020,0037)=0\\1\\0\\1\\0\\0' " + quoted(odd) + " 2>&1")
+                .exit_code,
+            0);
+  const std::string message = error_of([&] { read_dicom_series(series_.string()); });
+  EXPECT_NE(message.find("mixed ImageOrientationPatient"), std::string::npos) << message;
+  EXPECT_NE(message.find(odd.filename().string()), std::string::npos) << message;
+}
+
+/// DCMTK's encoders re-encode the written files; every codec must give back the same values.
+TEST_F(DicomSeriesTest, CompressedSeriesReadAlike) {
+  const ImageVolume plain = read_dicom_series(series_.string());
+  const std::map<std::string, std::string> encoders = {
+      {"dcmcjpeg", "dcmcjpeg +e1"},  // JPEG lossless, first-order prediction
+      {"dcmcjpls", "dcmcjpls +el"},  // JPEG-LS lossless
+      {"dcmcrle", "dcmcrle"}};
+  for (const auto& [tool, command] : encoders) {
+    if (!have_tool(tool)) GTEST_SKIP() << tool << " missing (Debian package dcmtk)";
+    const fs::path packed = tmp_ / tool;
+    fs::create_directories(packed);
+    for (const auto& file : files_in(series_))
+      ASSERT_EQ(run_command(command + " " + quoted(file) + " " + quoted(packed / file.filename()) +
+                            " 2>&1")
+                    .exit_code,
+                0)
+          << command;
+    const ImageVolume v = read_dicom_series(packed.string());
+    EXPECT_EQ(v.dims, plain.dims) << tool;
+    EXPECT_TRUE(v.affine_lps_m.isApprox(plain.affine_lps_m, 1e-12)) << tool;
+    EXPECT_EQ(v.values, plain.values) << tool;
+  }
+}
+
+// ---- writer rules ----------------------------------------------------------------------------
+
+TEST(DicomWrite, RefusesNonEmptyFolder) {
+  TempDir tmp;
+  const fs::path out = tmp / "out";
+  fs::create_directories(out);
+  FILE* f = std::fopen((out / "keep.txt").c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fclose(f);
+  const std::string message =
+      error_of([&] { write_dicom_series(out.string(), oblique_volume(), "x"); });
+  EXPECT_NE(message.find("not empty"), std::string::npos) << message;
+  EXPECT_EQ(files_in(out).size(), 1u);
+  EXPECT_EQ(files_in(tmp.path()).size(), 1u) << "no staging folder left behind";
+
+  fs::remove(out / "keep.txt");  // an empty folder is fine
+  write_dicom_series(out.string(), oblique_volume(), "x");
+  EXPECT_EQ(files_in(out).size(), 6u);
+}
+
+TEST(DicomWrite, RefusesShearedAffine) {
+  TempDir tmp;
+  ImageVolume v = oblique_volume();
+  v.affine_lps_m(0, 2) += 0.5e-3;  // k axis leans along x
+  const std::string message = error_of([&] { write_dicom_series((tmp / "out").string(), v, "x"); });
+  EXPECT_NE(message.find("sheared"), std::string::npos) << message;
+  EXPECT_FALSE(fs::exists(tmp / "out"));
+  EXPECT_TRUE(files_in(tmp.path()).empty()) << "no staging folder left behind";
+}
+
+/// A left-handed volume (k against row × column) is written at its true positions; it reads
+/// back with k reversed, so every voxel keeps its world position and value.
+TEST(DicomWrite, LeftHandedVolumeKeepsWorldPositions) {
+  TempDir tmp;
+  ImageVolume v = oblique_volume();
+  v.affine_lps_m.block<3, 1>(0, 2) *= -1;
+  write_dicom_series((tmp / "out").string(), v, "left-handed");
+  const ImageVolume back = read_dicom_series((tmp / "out").string());
+  ASSERT_EQ(back.dims, v.dims);
+  const int last = v.dims[2] - 1;
+  for (int k = 0; k <= last; ++k)
+    for (int j : {0, v.dims[1] - 1})
+      for (int i : {0, 5}) {
+        const Eigen::Vector3d ijk(i, j, k), mirrored(i, j, last - k);
+        EXPECT_LT((back.world_of_index(mirrored) - v.world_of_index(ijk)).norm(), 1e-6);
+        EXPECT_EQ(back.values[back.linear_index(i, j, last - k)],
+                  std::round(v.values[v.linear_index(i, j, k)]));
+      }
+}
+
+TEST(DicomWrite, SingleSliceUsesItsThickness) {
+  TempDir tmp;
+  const ImageVolume v = oblique_volume(1);
+  write_dicom_series((tmp / "out").string(), v, "one slice");
+  const ImageVolume back = read_dicom_series((tmp / "out").string());
+  EXPECT_EQ(back.dims, v.dims);
+  EXPECT_LT((back.affine_lps_m - v.affine_lps_m).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+/// Without source attributes (NIfTI, phantom) the writer starts a study with default patient.
+TEST(DicomWrite, DefaultsWithoutSourceTags) {
+  TempDir tmp;
+  ImageVolume v = oblique_volume(2);
+  v.dicom_tags.clear();
+  write_dicom_series((tmp / "out").string(), v, "phantom");
+  const ImageVolume back = read_dicom_series((tmp / "out").string());
+  EXPECT_EQ(back.dicom_tags.at("0010,0010"), "VoxBreast^Phantom");
+  EXPECT_EQ(back.dicom_tags.at("0010,0020"), "VOXBREAST");
+  EXPECT_FALSE(back.dicom_tags.at("0020,000D").empty());
+  EXPECT_FALSE(back.dicom_tags.at("0020,0052").empty());
+}
+
+/// Values beyond int16 with intercept −1024 get a fitted slope: still within half a step.
+TEST(DicomWrite, WideRangeGetsAFittedSlope) {
+  TempDir tmp;
+  ImageVolume v = oblique_volume(2);
+  v.values.front() = -60000.0f;
+  v.values.back() = 90000.0f;
+  write_dicom_series((tmp / "out").string(), v, "wide");
+  const ImageVolume back = read_dicom_series((tmp / "out").string());
+  const double step = (90000.0 + 60000.0) / 65535.0;
+  for (std::size_t n = 0; n < v.values.size(); ++n)
+    ASSERT_NEAR(back.values[n], v.values[n], 0.5 * step + 1e-3) << "voxel " << n;
+}
+
+TEST(DicomRead, FolderErrors) {
+  TempDir tmp;
+  EXPECT_NE(error_of([&] { read_dicom_series((tmp / "absent").string()); }).find("not a folder"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { read_dicom_series(tmp.path().string()); }).find("no DICOM files"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace vb
