@@ -29,6 +29,7 @@
 #include <sstream>
 
 #include "engine/error.hpp"
+#include "io/atomic_file.hpp"
 #include "voxbreast/config.hpp"
 
 namespace fs = std::filesystem;
@@ -183,8 +184,6 @@ std::vector<DicomHeader> scan_folder(const std::string& dir) {
   std::vector<DicomHeader> headers;
   for (const auto& path : paths)
     if (auto header = load_header(path)) headers.push_back(std::move(*header));
-  require(!headers.empty(), "no DICOM files in the folder", dir,
-          "give the folder that holds the series' files");
   return headers;
 }
 
@@ -215,6 +214,8 @@ std::string series_listing(const SeriesMap& series) {
 const std::vector<const DicomHeader*>& choose_series(const SeriesMap& series,
                                                      const std::string& uid,
                                                      const std::string& dir) {
+  require(!series.empty(), "no DICOM series in the folder", dir,
+          "give the folder that holds the series' files");
   if (uid.empty()) {
     require(series.size() == 1,
             "the folder holds " + std::to_string(series.size()) + " series:" +
@@ -518,13 +519,13 @@ struct Rescale {
 /// Slope 1 / intercept −1024 (the CT convention) when the rounded HU fit int16 that way,
 /// else a slope spreading [min, max] over the whole int16 range.
 Rescale choose_rescale(const std::vector<float>& values, const std::string& dir) {
-  const auto [low, high] = std::minmax_element(values.begin(), values.end());
-  const auto finite = std::find_if(values.begin(), values.end(),
-                                   [](float v) { return !std::isfinite(v); });
-  require(finite == values.end(),
+  const auto not_finite = std::find_if(values.begin(), values.end(),
+                                       [](float v) { return !std::isfinite(v); });
+  require(not_finite == values.end(),
           "the volume holds a non-finite value at index " +
-              std::to_string(finite - values.begin()),
+              std::to_string(not_finite - values.begin()),
           dir);
+  const auto [low, high] = std::minmax_element(values.begin(), values.end());
   Rescale rescale;
   const double stored_low = std::round(double(*low)) - rescale.intercept;
   const double stored_high = std::round(double(*high)) - rescale.intercept;
@@ -708,10 +709,9 @@ fs::path clean_output_path(const std::string& dir) {
   std::error_code ec;
   const bool occupied = fs::exists(path, ec) && !(fs::is_directory(path, ec) &&
                                                   fs::is_empty(path, ec));
-  require(!occupied, "the output folder exists and is not empty", dir,
+  require(!occupied, "the output path exists and is not an empty folder", dir,
           "choose a new folder; a DICOM series is never written over existing files");
-  fs::create_directories(path.parent_path(), ec);
-  require(!ec, "cannot create folder: " + ec.message(), path.parent_path().string());
+  ensure_output_dir(path.parent_path().string());
   return path;
 }
 

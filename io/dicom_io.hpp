@@ -15,8 +15,9 @@ struct DicomSeriesInfo {
   int files = 0;
 };
 
-/// The series of the DICOM files directly in `dir` (not recursive), sorted by UID. Files that are
-/// not DICOM are skipped silently; a DICOM file that cannot be parsed is a vb::Error naming it.
+/// The series of the DICOM files directly in `dir` (not recursive), sorted by UID; empty when there
+/// are none. Files that are not DICOM are skipped silently; a DICOM file that cannot be parsed
+/// (truncated, corrupt) is a vb::Error naming it.
 std::vector<DicomSeriesInfo> list_dicom_series(const std::string& dir);
 
 struct DicomReadOptions {

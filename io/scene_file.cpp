@@ -682,7 +682,7 @@ void check_labels(Scene& scene, const std::string& source) {
   for (const auto& entry : scene.materials) names.push_back(entry.first);
   for (const std::string& d : default_material_names()) names.push_back(d);
   auto resolve = [&](const std::string& tissue, int line, const std::string& key) {
-    if (scene.materials.count(tissue)) return;
+    if (scene.materials.count(tissue) || tissue == "air") return;  // "air": not modelled
     if (auto d = default_material(tissue)) {
       scene.materials[tissue] = *d;
       return;

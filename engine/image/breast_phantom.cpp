@@ -39,8 +39,8 @@ constexpr double kGlandBlobSigmaMin_m = 0.0025;
 constexpr double kGlandBlobSigmaMax_m = 0.005;
 constexpr double kGlandBlobWeightMax = 1.5;
 constexpr double kGlandThreshold = 0.5;
-const Eigen::Vector3d kGlandCentreFraction{0.0, -0.45, 0.0};  // of the breast radii: behind the nipple
-const Eigen::Vector3d kGlandExtentFraction{0.55, 0.6, 0.55};
+constexpr double kGlandCentreDepthFraction = 0.45;  // of the breast depth: behind the nipple
+constexpr double kGlandExtentFraction = 0.57;       // of each breast radius
 
 // Keeps a phantom request from exhausting memory (two float volumes plus a copy).
 constexpr double kMaxVoxels = 5.0e7;
@@ -77,7 +77,7 @@ const TumourType& tumour_type(std::string_view name, const std::string& where) {
 
 // ---------------------------------------------------------------- anatomy (analytic, LPS m)
 
-/// Σ(p/r)² over the breast radii: < 1 inside the ellipsoid whose y < 0 half is the mound.
+/// Σ(p/r)² over the breast radii: ≤ 1 inside the ellipsoid whose y < 0 half is the mound.
 double breast_mound_level(const Eigen::Vector3d& p, const PhantomSpec& spec) {
   return (p.array() / spec.breast_radii_m.array()).square().sum();
 }
@@ -86,12 +86,12 @@ bool in_breast_mound(const Eigen::Vector3d& p, const PhantomSpec& spec) {
   return p.y() < 0.0 && breast_mound_level(p, spec) <= 1.0;
 }
 
-/// Elliptic radius of p about the nearest rib axis (ribs run along x): 0 on the axis, 1 on the
-/// bone surface.
+/// Elliptic radius of p about the nearest rib axis: 0 on the axis, 1 on the bone surface. Ribs
+/// run along x just behind the pectoral muscle, one every rib_pitch_m in z.
 double rib_level(const Eigen::Vector3d& p, const PhantomSpec& spec) {
-  const double dy_m = p.y() - spec.rib_center_y_m;
+  const double dy_m = p.y() - (spec.pectoral_thickness_m + spec.rib_half_thickness_m);
   const double dz_m = p.z() - spec.rib_pitch_m * std::round(p.z() / spec.rib_pitch_m);
-  return std::hypot(dy_m / spec.rib_radii_m.x(), dz_m / spec.rib_radii_m.y());
+  return std::hypot(dy_m / spec.rib_half_thickness_m, dz_m / spec.rib_half_height_m);
 }
 
 /// Posterior to y = 0: ribs in muscle (pectoral in front, intercostal/chest-wall tissue around).
@@ -130,7 +130,7 @@ std::vector<GlandBlob> draw_gland_blobs(const PhantomSpec& spec, std::mt19937_64
   return blobs;
 }
 
-/// Smooth zero-mean texture: the sum of the blobs (each cut at 3σ, where it is below 1.2%).
+/// Smooth zero-mean texture: the sum of the blobs (each cut at 3σ, where it has fallen to 1.1%).
 /// blobs are sorted by centre z.
 double blob_noise(const Eigen::Vector3d& p, const std::vector<GlandBlob>& blobs) {
   const double reach_m = 3.0 * kGlandBlobSigmaMax_m;
@@ -149,8 +149,8 @@ double blob_noise(const Eigen::Vector3d& p, const std::vector<GlandBlob>& blobs)
 /// blobs so the edge is irregular and fat is interspersed; near the skin the envelope vanishes,
 /// leaving a subcutaneous fat layer.
 bool is_glandular(const Eigen::Vector3d& p, const PhantomSpec& spec, const std::vector<GlandBlob>& blobs) {
-  const Eigen::Vector3d centre_m = kGlandCentreFraction.cwiseProduct(spec.breast_radii_m);
-  const Eigen::Vector3d extent_m = kGlandExtentFraction.cwiseProduct(spec.breast_radii_m);
+  const Eigen::Vector3d centre_m(0.0, -kGlandCentreDepthFraction * spec.breast_radii_m.y(), 0.0);
+  const Eigen::Vector3d extent_m = kGlandExtentFraction * spec.breast_radii_m;
   const double envelope = std::exp(-((p - centre_m).array() / extent_m.array()).square().sum());
   return envelope * (1.0 + blob_noise(p, blobs)) > kGlandThreshold;
 }
@@ -187,14 +187,14 @@ void validate_geometry(const PhantomSpec& spec) {
           "phantom.skin_thickness_m");
   require(positive(spec.pectoral_thickness_m), "pectoral thickness must be positive",
           "phantom.pectoral_thickness_m");
-  require(positive(spec.rib_radii_m.x()) && positive(spec.rib_radii_m.y()), "rib radii must be positive",
-          "phantom.rib_radii_m");
-  require(std::isfinite(spec.rib_center_y_m) &&
-              spec.rib_center_y_m - spec.rib_radii_m.x() >= spec.pectoral_thickness_m &&
-              spec.rib_center_y_m + spec.rib_radii_m.x() <= spec.chest_wall_depth_m,
-          "ribs must lie between the pectoral muscle and the back of the chest wall slab",
-          "phantom.rib_center_y_m", "pectoral_thickness_m ≤ rib_center_y_m ± rib_radii_m.y ≤ chest_wall_depth_m");
-  require(positive(spec.rib_pitch_m) && spec.rib_pitch_m > 2.0 * spec.rib_radii_m.y(),
+  require(positive(spec.rib_half_thickness_m) && positive(spec.rib_half_height_m),
+          "rib half-thickness and half-height must be positive", "phantom.rib_half_thickness_m");
+  require(std::isfinite(spec.chest_wall_depth_m) &&
+              spec.pectoral_thickness_m + 2.0 * spec.rib_half_thickness_m <= spec.chest_wall_depth_m,
+          "the pectoral muscle and the ribs behind it must fit in the chest wall slab, got depth " +
+              mm_text(spec.chest_wall_depth_m),
+          "phantom.chest_wall_depth_m", "pectoral_thickness_m + 2·rib_half_thickness_m ≤ chest_wall_depth_m");
+  require(positive(spec.rib_pitch_m) && spec.rib_pitch_m > 2.0 * spec.rib_half_height_m,
           "rib pitch must exceed the rib height so ribs stay apart", "phantom.rib_pitch_m");
   require(std::isfinite(spec.fov_margin_m) && spec.fov_margin_m >= spec.spacing_m,
           "field-of-view margin must be at least one voxel (air must surround the breast)",

@@ -38,9 +38,9 @@ struct PhantomSpec {
   /// supine), z half-height. The mound is the half-ellipsoid y < 0 centred at the origin.
   Eigen::Vector3d breast_radii_m{0.07, 0.04, 0.065};
   double skin_thickness_m = 0.002;      ///< at least one voxel whatever the spacing
-  double pectoral_thickness_m = 0.010;  ///< muscle layer just posterior to y = 0
-  double rib_center_y_m = 0.018;        ///< depth of the rib axes behind y = 0
-  Eigen::Vector2d rib_radii_m{0.004, 0.007};  ///< rib cross-section semi-axes (y, z)
+  double pectoral_thickness_m = 0.010;  ///< muscle between y = 0 and the front of the ribs
+  double rib_half_thickness_m = 0.004;  ///< rib cross-section semi-axis along y
+  double rib_half_height_m = 0.007;     ///< rib cross-section semi-axis along z
   double rib_pitch_m = 0.025;           ///< superior–inferior distance between rib axes (one at z = 0)
   double chest_wall_depth_m = 0.030;    ///< torso slab kept in the field of view, posterior to y = 0
   double fov_margin_m = 0.015;          ///< field of view beyond the mound in x, −y and z

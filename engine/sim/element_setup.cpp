@@ -13,6 +13,7 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
   const double volume = std::pow(lattice.spacing_m, 3);
 
   std::vector<double> E_of_tissue, mass_of_tissue;
+  std::vector<bool> rigid_tissue;  // held in place (bone)
   for (const std::string& tissue : lattice.tissue_names) {
     auto it = scene.materials.find(tissue);
     require(it != scene.materials.end(), "tissue '" + tissue + "' has no material", "materials." + tissue);
@@ -22,6 +23,7 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
     require(m.density_kg_m3 > 0 && std::isfinite(m.density_kg_m3), "density must be positive", where);
     E_of_tissue.push_back(m.youngs_modulus_pa);
     mass_of_tissue.push_back(m.density_kg_m3 * volume);
+    rigid_tissue.push_back(m.rigid);
   }
 
   ElementArrays a;
@@ -34,9 +36,9 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
     const int t = lattice.tissue_of_element[e];
     a.youngs_modulus_pa[e] = E_of_tissue[t];
     a.mass_kg[e] = mass_of_tissue[t];
-    a.inverse_mass[e] = anchors.held[e] ? 0.0 : 1.0 / mass_of_tissue[t];
+    a.inverse_mass[e] = anchors.held[e] || rigid_tissue[t] ? 0.0 : 1.0 / mass_of_tissue[t];
     for (int c = 0; c < 3; ++c) a.displacement_m[3 * e + c] = anchors.displacement_m[e][c];
-    a.held_count += anchors.held[e];
+    a.held_count += a.inverse_mass[e] == 0;
   }
   require(a.held_count < n || n == 0, "every element is held by an anchor; nothing can move", "anchor");
   return a;

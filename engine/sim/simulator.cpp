@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "engine/error.hpp"
+#include "engine/image/image_lattice.hpp"
 #include "engine/sim/kernel_tables.hpp"
 
 namespace vb {
@@ -33,6 +34,14 @@ void unpack4(const std::vector<T>& in, std::vector<double>& xyz) {
 
 std::string mib(double bytes) { return std::to_string(static_cast<long long>(bytes / (1 << 20))) + " MiB"; }
 
+/// Smallest downsample factor f whose model (about bytes/f³) fits the device.
+int fitting_downsample(std::size_t bytes, const DeviceInfo& device) {
+  const double budget = 0.9 * double(device.global_memory_bytes);
+  int f = 2;
+  while (double(bytes) / (f * f * f) > budget && f < 64) ++f;
+  return f;
+}
+
 }  // namespace
 
 Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const ClContext& cl)
@@ -60,13 +69,14 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
           "downsample or crop the model");
 
   const std::size_t state_bytes = 4 * real_size_ * n_;
-  device_bytes_ = 4 * state_bytes + n_ * (real_size_ + sizeof(cl_uint)) + cells * sizeof(cl_int);
+  device_bytes_ = estimated_device_bytes(n_, cells, precision_);
   require(double(device_bytes_) < 0.9 * double(cl.info.global_memory_bytes) &&
               std::max(state_bytes, cells * sizeof(cl_int)) <= cl.info.max_allocation_bytes,
           "the model needs " + mib(double(device_bytes_)) + " of device memory but '" + cl.info.name +
               "' has " + mib(double(cl.info.global_memory_bytes)) + " (largest buffer " +
               mib(double(cl.info.max_allocation_bytes)) + ")",
-          "model", "downsample the model, crop it, or use float precision");
+          "model", "set model.downsample to at least " + std::to_string(fitting_downsample(device_bytes_, cl.info)) +
+                       ", crop the model (model.roi_min/max, model.keep), or use float precision");
 
   std::vector<cl_int> grid(cells, -1);
   std::vector<cl_uint> cell_of(n_);
