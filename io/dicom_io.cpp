@@ -56,15 +56,23 @@ void init_dcmtk() {
 // ---- attributes carried from a source series to derived series --------------------------------
 
 /// Patient and study attributes (plus the character set they are encoded in).
-const std::array<DcmTagKey, 13> kCarriedTags = {
-    DCM_SpecificCharacterSet, DCM_PatientName,      DCM_PatientID,
-    DCM_PatientBirthDate,     DCM_PatientSex,       DCM_StudyInstanceUID,
-    DCM_StudyID,              DCM_StudyDate,        DCM_StudyTime,
-    DCM_AccessionNumber,      DCM_ReferringPhysicianName, DCM_StudyDescription,
-    DCM_FrameOfReferenceUID};
+const std::array<DcmTagKey, 13> kCarriedTags = {DCM_SpecificCharacterSet,
+                                                DCM_PatientName,
+                                                DCM_PatientID,
+                                                DCM_PatientBirthDate,
+                                                DCM_PatientSex,
+                                                DCM_StudyInstanceUID,
+                                                DCM_StudyID,
+                                                DCM_StudyDate,
+                                                DCM_StudyTime,
+                                                DCM_AccessionNumber,
+                                                DCM_ReferringPhysicianName,
+                                                DCM_StudyDescription,
+                                                DCM_FrameOfReferenceUID};
 
 constexpr const char* kSourceSeriesKey = "source_series_uid";
-constexpr const char* kCorruptFileHint = "the file may be truncated or corrupt; remove or replace it";
+constexpr const char* kCorruptFileHint =
+    "the file may be truncated or corrupt; remove or replace it";
 
 /// "gggg,eeee" in upper-case hex, as the standard prints tags.
 std::string tag_key_text(const DcmTagKey& key) {
@@ -107,10 +115,10 @@ Eigen::Matrix<double, count, 1> require_numbers(DcmItem& item, const DcmTagKey& 
   Eigen::Matrix<double, count, 1> values;
   for (int n = 0; n < count; ++n) {
     const auto value = get_number(item, key, unsigned(n));
-    require(value.has_value(),
-            "missing or malformed " + tag_name(key) + " (needs " + std::to_string(count) +
-                " numbers)",
-            path);
+    require(
+        value.has_value(),
+        "missing or malformed " + tag_name(key) + " (needs " + std::to_string(count) + " numbers)",
+        path);
     values[n] = *value;
   }
   return values;
@@ -134,7 +142,8 @@ struct DicomHeader {
 enum class FileKind { part10, bare_dataset, other };
 
 /// Part 10 files carry "DICM" after a 128-byte preamble; files without it are tried as bare
-/// datasets only when they start with a group 0002 or 0008 tag, so arbitrary files are never parsed.
+/// datasets only when they start with a group 0002 or 0008 tag, so arbitrary files are never
+/// parsed.
 FileKind sniff(const std::string& path) {
   std::array<char, 132> head{};
   std::ifstream in(path, std::ios::binary);
@@ -150,14 +159,12 @@ std::optional<DicomHeader> load_header(const std::string& path) {
   const FileKind kind = sniff(path);
   if (kind == FileKind::other) return std::nullopt;
   auto file = std::make_unique<DcmFileFormat>();
-  const OFCondition status =
-      file->loadFileUntilTag(path.c_str(), EXS_Unknown, EGL_noChange, DCM_MaxReadLength,
-                             kind == FileKind::part10 ? ERM_autoDetect : ERM_dataset,
-                             DCM_PixelData);
+  const OFCondition status = file->loadFileUntilTag(
+      path.c_str(), EXS_Unknown, EGL_noChange, DCM_MaxReadLength,
+      kind == FileKind::part10 ? ERM_autoDetect : ERM_dataset, DCM_PixelData);
   if (status.bad()) {
     if (kind == FileKind::bare_dataset) return std::nullopt;  // a guess that did not pan out
-    throw Error(std::string("cannot parse DICOM file: ") + status.text(), path,
-                kCorruptFileHint);
+    throw Error(std::string("cannot parse DICOM file: ") + status.text(), path, kCorruptFileHint);
   }
   DicomHeader header{path, std::move(file)};
   if (!header.series_uid().empty()) return header;
@@ -166,8 +173,7 @@ std::optional<DicomHeader> load_header(const std::string& path) {
   const bool dicomdir = get_text(*header.file->getMetaInfo(), DCM_MediaStorageSOPClassUID) ==
                         UID_MediaStorageDirectoryStorage;
   require(kind == FileKind::bare_dataset || dicomdir,
-          "DICOM file without SeriesInstanceUID (0020,000E)", path,
-          kCorruptFileHint);
+          "DICOM file without SeriesInstanceUID (0020,000E)", path, kCorruptFileHint);
   return std::nullopt;
 }
 
@@ -217,16 +223,16 @@ const std::vector<const DicomHeader*>& choose_series(const SeriesMap& series,
   require(!series.empty(), "no DICOM series in the folder", dir,
           "give the folder that holds the series' files");
   if (uid.empty()) {
-    require(series.size() == 1,
-            "the folder holds " + std::to_string(series.size()) + " series:" +
-                series_listing(series),
-            dir, "choose one with --series UID");
+    require(
+        series.size() == 1,
+        "the folder holds " + std::to_string(series.size()) + " series:" + series_listing(series),
+        dir, "choose one with --series UID");
     return series.begin()->second;
   }
   const auto found = series.find(uid);
-  require(found != series.end(), "no series " + uid + " in the folder; it holds:" +
-                                     series_listing(series),
-          dir, "choose one of the listed UIDs with --series UID");
+  require(found != series.end(),
+          "no series " + uid + " in the folder; it holds:" + series_listing(series), dir,
+          "choose one of the listed UIDs with --series UID");
   return found->second;
 }
 
@@ -235,13 +241,13 @@ const std::vector<const DicomHeader*>& choose_series(const SeriesMap& series,
 /// Where one slice lies (mm, LPS) and what its pixel grid is.
 struct Slice {
   std::string path;
-  Eigen::Vector3d position_mm;     ///< ImagePositionPatient: centre of the first pixel
-  Eigen::Vector3d row_direction;   ///< along a row: the direction of increasing column index
+  Eigen::Vector3d position_mm;    ///< ImagePositionPatient: centre of the first pixel
+  Eigen::Vector3d row_direction;  ///< along a row: the direction of increasing column index
   Eigen::Vector3d column_direction;
-  double row_spacing_mm = 0;       ///< PixelSpacing[0]: between rows, i.e. along a column
-  double column_spacing_mm = 0;    ///< PixelSpacing[1]: between columns, i.e. along a row
+  double row_spacing_mm = 0;     ///< PixelSpacing[0]: between rows, i.e. along a column
+  double column_spacing_mm = 0;  ///< PixelSpacing[1]: between columns, i.e. along a row
   int rows = 0, columns = 0;
-  double along_normal_mm = 0;      ///< position · slice normal, the sort key
+  double along_normal_mm = 0;  ///< position · slice normal, the sort key
 };
 
 Slice read_slice_geometry(const DicomHeader& header) {
@@ -271,7 +277,9 @@ Slice read_slice_geometry(const DicomHeader& header) {
 /// All slices must share one pixel grid and orientation: anything else is not one volume.
 void check_same_grid(const std::vector<Slice>& slices) {
   const Slice& first = slices.front();
-  auto close = [](double a, double b) { return std::abs(a - b) <= 1e-4 * std::max(1.0, std::abs(a)); };
+  auto close = [](double a, double b) {
+    return std::abs(a - b) <= 1e-4 * std::max(1.0, std::abs(a));
+  };
   for (const Slice& s : slices) {
     require(s.rows == first.rows && s.columns == first.columns,
             "mixed image sizes in one series: " + std::to_string(s.columns) + "×" +
@@ -284,8 +292,9 @@ void check_same_grid(const std::vector<Slice>& slices) {
             "the series is not one volume; choose another series");
     const double turn = std::max((s.row_direction - first.row_direction).norm(),
                                  (s.column_direction - first.column_direction).norm());
-    require(turn < 1e-4, "mixed ImageOrientationPatient in one series (differs from " +
-                             first.path + "; a localizer mixed in?)",
+    require(turn < 1e-4,
+            "mixed ImageOrientationPatient in one series (differs from " + first.path +
+                "; a localizer mixed in?)",
             s.path, "the series is not one volume; choose another series");
   }
 }
@@ -309,8 +318,9 @@ double stack_spacing_mm(const std::vector<Slice>& sorted, bool allow_gaps,
   std::vector<double> gaps;
   for (std::size_t n = 1; n < sorted.size(); ++n) {
     const double gap = sorted[n].along_normal_mm - sorted[n - 1].along_normal_mm;
-    require(gap > 1e-3, "duplicate slice position " + mm_text(sorted[n].along_normal_mm) +
-                            " along the normal, shared with " + sorted[n - 1].path,
+    require(gap > 1e-3,
+            "duplicate slice position " + mm_text(sorted[n].along_normal_mm) +
+                " along the normal, shared with " + sorted[n - 1].path,
             sorted[n].path, "remove the duplicate file or choose another series");
     gaps.push_back(gap);
   }
@@ -485,7 +495,7 @@ void carry_tags(DcmDataset& data, ImageVolume& volume) {
 
 /// Slice grid of a volume in DICOM terms (mm, LPS).
 struct WriteGeometry {
-  Eigen::Vector3d row_direction, column_direction;  ///< voxel axes i and j, unit
+  Eigen::Vector3d row_direction, column_direction;   ///< voxel axes i and j, unit
   double column_spacing_mm = 0, row_spacing_mm = 0;  ///< |axis i|, |axis j|
   Eigen::Vector3d origin_mm, slice_step_mm;          ///< voxel (0,0,0), axis k
 };
@@ -519,12 +529,12 @@ struct Rescale {
 /// Slope 1 / intercept −1024 (the CT convention) when the rounded HU fit int16 that way,
 /// else a slope spreading [min, max] over the whole int16 range.
 Rescale choose_rescale(const std::vector<float>& values, const std::string& dir) {
-  const auto not_finite = std::find_if(values.begin(), values.end(),
-                                       [](float v) { return !std::isfinite(v); });
-  require(not_finite == values.end(),
-          "the volume holds a non-finite value at index " +
-              std::to_string(not_finite - values.begin()),
-          dir);
+  const auto not_finite =
+      std::find_if(values.begin(), values.end(), [](float v) { return !std::isfinite(v); });
+  require(
+      not_finite == values.end(),
+      "the volume holds a non-finite value at index " + std::to_string(not_finite - values.begin()),
+      dir);
   const auto [low, high] = std::minmax_element(values.begin(), values.end());
   Rescale rescale;
   const double stored_low = std::round(double(*low)) - rescale.intercept;
@@ -647,8 +657,7 @@ void write_slice(const std::string& path, const SeriesAttributes& series, const 
   put.text(DCM_PixelSpacing, ds_list(Eigen::Vector2d(g.row_spacing_mm, g.column_spacing_mm)));
   put.text(DCM_SliceThickness, ds_text(g.slice_step_mm.norm()));
   put.text(DCM_SpacingBetweenSlices, ds_text(g.slice_step_mm.norm()));
-  put.text(DCM_SliceLocation,
-           ds_text(position.dot(g.row_direction.cross(g.column_direction))));
+  put.text(DCM_SliceLocation, ds_text(position.dot(g.row_direction.cross(g.column_direction))));
 
   put.number(DCM_SamplesPerPixel, 1);
   put.text(DCM_PhotometricInterpretation, "MONOCHROME2");
@@ -662,8 +671,8 @@ void write_slice(const std::string& path, const SeriesAttributes& series, const 
   put.text(DCM_RescaleSlope, ds_text(series.rescale.slope));
   put.text(DCM_RescaleType, "HU");
   const std::size_t slice_voxels = std::size_t(ct.dims[0]) * std::size_t(ct.dims[1]);
-  put.words(DCM_PixelData, stored_pixels(&ct.values[ct.linear_index(0, 0, k)], slice_voxels,
-                                         series.rescale));
+  put.words(DCM_PixelData,
+            stored_pixels(&ct.values[ct.linear_index(0, 0, k)], slice_voxels, series.rescale));
 
   const OFCondition status = file.saveFile(path.c_str(), EXS_LittleEndianExplicit);
   require(status.good(), std::string("cannot write DICOM file: ") + status.text(), path);
@@ -707,8 +716,8 @@ fs::path clean_output_path(const std::string& dir) {
   fs::path path = fs::absolute(fs::path(dir)).lexically_normal();
   if (path.filename().empty()) path = path.parent_path();  // "out/" → "out"
   std::error_code ec;
-  const bool occupied = fs::exists(path, ec) && !(fs::is_directory(path, ec) &&
-                                                  fs::is_empty(path, ec));
+  const bool occupied =
+      fs::exists(path, ec) && !(fs::is_directory(path, ec) && fs::is_empty(path, ec));
   require(!occupied, "the output path exists and is not an empty folder", dir,
           "choose a new folder; a DICOM series is never written over existing files");
   ensure_output_dir(path.parent_path().string());
@@ -748,10 +757,10 @@ ImageVolume read_dicom_series(const std::string& dir, const DicomReadOptions& op
 
   ImageVolume volume;
   volume.modality = get_text(files.front()->data(), DCM_Modality);
-  require(options.accept_any_modality || volume.modality == "CT",
-          "not a CT series (modality " + (volume.modality.empty() ? "unknown" : volume.modality) +
-              ")",
-          files.front()->path, "give a CT series");
+  require(
+      options.accept_any_modality || volume.modality == "CT",
+      "not a CT series (modality " + (volume.modality.empty() ? "unknown" : volume.modality) + ")",
+      files.front()->path, "give a CT series");
 
   std::vector<std::string> stack_warnings;
   const StackGeometry stack = stack_geometry(files, options.allow_gaps, stack_warnings);

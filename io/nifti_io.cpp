@@ -6,12 +6,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdlib>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <memory>
 #include <string>
+#include <system_error>
 #include <type_traits>
 #include <vector>
 
@@ -34,10 +35,13 @@ void quiet_nifti_clib() {
   (void)quiet;
 }
 
-constexpr int kVectorComponents = 3;
+constexpr std::size_t kVectorComponents = 3;
 constexpr double kMetresPerMm = 1e-3;
 /// NIfTI-1 header (348 bytes) + the 4-byte extension flag: where the voxels start.
 constexpr int kNifti1DataOffset = 352;
+
+/// Sign of each vector component between LPS and RAS (either way).
+constexpr std::array<double, 3> kLpsRasSign{-1.0, -1.0, 1.0};
 
 /// Flips x and y: RAS <-> LPS (its own inverse).
 const Eigen::Matrix4d& ras_lps_flip() {
@@ -110,8 +114,8 @@ NiftiPtr open_header(const std::string& path) {
   NiftiPtr nim(nifti_image_read(path.c_str(), /*read_data=*/0));
   require(nim != nullptr, "not a readable NIfTI file (bad or truncated header)", path,
           "check that the file is a complete .nii or .nii.gz file");
-  require(nim->nifti_type != NIFTI_FTYPE_ANALYZE,
-          "ANALYZE 7.5 file: it has no defined orientation", path, "convert it to NIfTI");
+  require(nim->nifti_type != NIFTI_FTYPE_ANALYZE, "ANALYZE 7.5 file: it has no defined orientation",
+          path, "convert it to NIfTI");
   require(with_voxel_type(nim->datatype, [](auto) {}),
           std::string("unsupported voxel type ") + nifti_datatype_string(nim->datatype), path,
           "use int8/16/32, uint8/16/32, float32 or float64");
@@ -120,9 +124,8 @@ NiftiPtr open_header(const std::string& path) {
 
 /// Loads the voxels after the header has been accepted; a short read is a truncated file.
 void load_voxels(nifti_image& nim, const std::string& path) {
-  require(nifti_image_load(&nim) >= 0 && nim.data != nullptr,
-          "voxel data missing or truncated", path,
-          "the file is incomplete or corrupt; write or download it again");
+  require(nifti_image_load(&nim) >= 0 && nim.data != nullptr, "voxel data missing or truncated",
+          path, "the file is incomplete or corrupt; write or download it again");
 }
 
 /// dim[5..7] must be 1 except as listed; dim[4] (time) must be 1.
@@ -189,9 +192,10 @@ ImageVolume read_grid(const nifti_image& nim, const std::string& path) {
   ImageVolume grid;
   for (int d = 0; d < 3; ++d) {
     const std::int64_t n = d < nim.dim[0] ? nim.dim[d + 1] : 1;
-    require(n >= 1 && n <= std::numeric_limits<int>::max(),
-            "grid size dim[" + std::to_string(d + 1) + "] = " + std::to_string(n) + " not supported",
-            path);
+    require(
+        n >= 1 && n <= std::numeric_limits<int>::max(),
+        "grid size dim[" + std::to_string(d + 1) + "] = " + std::to_string(n) + " not supported",
+        path);
     grid.dims[std::size_t(d)] = int(n);
   }
   grid.affine_lps_m = ras_lps_flip() * file_affine(nim, path);
@@ -231,7 +235,8 @@ LoadedNifti load(const std::string& path, int components) {
 // ---- writing ---------------------------------------------------------------------------------
 
 bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 bool gzip_for(const std::string& path) {
@@ -246,11 +251,13 @@ NiftiPtr new_image(const std::array<int, 3>& dims, int components, int datatype,
                    const std::string& path) {
   quiet_nifti_clib();
   check_dims(dims, path);
-  const std::int64_t dim[8] = {components == 1 ? 3 : 5, dims[0], dims[1], dims[2], 1,
-                               components,                1,       1};
+  const std::int64_t dim[8] = {
+      components == 1 ? 3 : 5, dims[0], dims[1], dims[2], 1, components, 1, 1};
   NiftiPtr nim(nifti_make_new_nim(dim, datatype, /*data_fill=*/1));
   require(nim != nullptr && nim->data != nullptr, "cannot allocate the NIfTI image", path);
   nim->nifti_type = NIFTI_FTYPE_NIFTI1_1;
+  nim->scl_slope = 1.0;  // stored values are the values
+  nim->scl_inter = 0.0;
   return nim;
 }
 
@@ -268,8 +275,8 @@ void set_geometry(nifti_image& nim, const Eigen::Matrix4d& affine_lps_m, const s
                           &nim.pixdim[2], &nim.pixdim[3], &nim.qfac);
   nim.pixdim[0] = nim.qfac;
   nim.qto_xyz = nifti_quatern_to_dmat44(nim.quatern_b, nim.quatern_c, nim.quatern_d, nim.qoffset_x,
-                                        nim.qoffset_y, nim.qoffset_z, nim.pixdim[1],
-                                        nim.pixdim[2], nim.pixdim[3], nim.qfac);
+                                        nim.qoffset_y, nim.qoffset_z, nim.pixdim[1], nim.pixdim[2],
+                                        nim.pixdim[3], nim.qfac);
   nim.qto_ijk = nifti_dmat44_inverse(nim.qto_xyz);
   nim.xyz_units = NIFTI_UNITS_MM;
   nifti_update_dims_from_array(&nim);  // copies pixdim[] into dx, dy, dz
@@ -344,10 +351,9 @@ void write_nifti(const std::string& path, const ImageVolume& image, NiftiType ty
           path);
   NiftiPtr nim = new_image(image.dims, 1, datatype_of(type), path);
   set_geometry(*nim, image.affine_lps_m, path);
-  nim->scl_slope = 1.0;
-  nim->scl_inter = 0.0;
   if (image.modality == "LABEL") nim->intent_code = NIFTI_INTENT_LABEL;
-  set_text(nim->descrip, sizeof nim->descrip, "VoxBreast " + image.modality);
+  set_text(nim->descrip, sizeof nim->descrip,
+           image.modality.empty() ? "VoxBreast" : "VoxBreast " + image.modality);
   with_voxel_type(nim->datatype, [&](auto tag) {
     using T = decltype(tag);
     auto* out = static_cast<T*>(nim->data);
@@ -364,7 +370,7 @@ void write_nifti_displacement(const std::string& path, const ImageVolume& grid,
           "displacement has " + std::to_string(displacement_lps_m.size()) + " floats for " +
               std::to_string(n) + " voxels (3 per voxel expected)",
           path);
-  NiftiPtr nim = new_image(grid.dims, kVectorComponents, NIFTI_TYPE_FLOAT32, path);
+  NiftiPtr nim = new_image(grid.dims, int(kVectorComponents), NIFTI_TYPE_FLOAT32, path);
   set_geometry(*nim, grid.affine_lps_m, path);
   nim->intent_code = NIFTI_INTENT_DISPVECT;
   set_text(nim->intent_name, sizeof nim->intent_name, "displacement");
@@ -372,10 +378,10 @@ void write_nifti_displacement(const std::string& path, const ImageVolume& grid,
   // NIfTI stores the component axis slowest (dim[5]); components in the file's RAS frame, mm.
   auto* out = static_cast<float*>(nim->data);
   for (std::size_t i = 0; i < n; ++i) {
-    for (int c = 0; c < kVectorComponents; ++c) {
-      const float u = displacement_lps_m[kVectorComponents * i + std::size_t(c)];
+    for (std::size_t c = 0; c < kVectorComponents; ++c) {
+      const float u = displacement_lps_m[kVectorComponents * i + c];
       require(std::isfinite(u), "displacement is not finite at " + voxel_name(grid.dims, i), path);
-      out[std::size_t(c) * n + i] = float(ras_lps_flip()(c, c) * double(u) / kMetresPerMm);
+      out[c * n + i] = float(kLpsRasSign[c] * double(u) / kMetresPerMm);
     }
   }
   write_file(path, *nim);
@@ -383,15 +389,16 @@ void write_nifti_displacement(const std::string& path, const ImageVolume& grid,
 
 ImageVolume read_nifti_displacement(const std::string& path,
                                     std::vector<float>& displacement_lps_m) {
-  LoadedNifti file = load(path, kVectorComponents);
+  LoadedNifti file = load(path, int(kVectorComponents));
   const int intent = file.nim->intent_code;
   require(intent == NIFTI_INTENT_DISPVECT || intent == NIFTI_INTENT_VECTOR,
           "intent code " + std::to_string(intent) + " is not a displacement field", path,
           "expected 1006 (NIFTI_INTENT_DISPVECT) or 1007 (NIFTI_INTENT_VECTOR)");
   // DISPVECT components are RAS (ITK >= 5.4, Slicer); VECTOR ones are ITK's LPS, unconverted.
-  const double flip_xy = intent == NIFTI_INTENT_DISPVECT ? -1.0 : 1.0;
   const double unit = metres_per_unit(*file.nim, path);
-  const std::array<double, 3> factor{flip_xy * unit, flip_xy * unit, unit};
+  std::array<double, 3> factor{unit, unit, unit};
+  if (intent == NIFTI_INTENT_DISPVECT)
+    for (std::size_t c = 0; c < kVectorComponents; ++c) factor[c] *= kLpsRasSign[c];
 
   const std::vector<float> stored = scaled_values(*file.nim);
   const std::size_t n = file.grid.voxel_count();

@@ -667,11 +667,17 @@ StopSpec read_stop(const Section& s) {
   return stop;
 }
 
-OutputSpec read_output(const Section& s) {
-  s.check_keys({"frames_every"},
-               {{"dvf", kLaterVersion}, {"warped_ct", kLaterVersion}, {"surfaces", kLaterVersion}});
+OutputSpec read_output(const Section& s, const ModelSpec& model) {
+  s.check_keys({"frames_every", "dvf", "warped_ct", "warped_ct_dicom", "fields"}, {{"surfaces", kLaterVersion}});
   OutputSpec out;
   out.frames_every = s.integer<int>("frames_every", 0).value_or(out.frames_every);
+  for (const char* key : {"dvf", "warped_ct", "warped_ct_dicom", "fields"}) {
+    if (s.find(key) && !model.from_image()) s.fail(key, "needs a CT image model (model.image)");
+  }
+  out.dvf = s.boolean("dvf").value_or(out.dvf);
+  out.warped_ct = s.boolean("warped_ct").value_or(out.warped_ct);
+  out.warped_ct_dicom = s.boolean("warped_ct_dicom").value_or(out.warped_ct_dicom);
+  out.fields = s.boolean("fields").value_or(out.fields);
   return out;
 }
 
@@ -749,7 +755,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
   for (const Section& s : top.tables("indenter")) scene.indenters.push_back(read_indenter(s));
   scene.tracks = read_tracks(top.tables("track"));
   scene.stop = read_stop(top.table_or_empty("stop"));
-  scene.output = read_output(top.table_or_empty("output"));
+  scene.output = read_output(top.table_or_empty("output"), scene.model);
   check_labels(scene, source_name);
   scene.source_text = text;
   return scene;

@@ -120,6 +120,11 @@ struct StopSpec {
 
 struct OutputSpec {
   int frames_every = 0;  ///< store displacement frames every N steps in result.h5 (0: none)
+  // Image models only: results on the input CT's grid (docs/OUTPUTS.md).
+  bool dvf = true;              ///< dvf.nii.gz (forward) and dvf_inverse.nii.gz
+  bool warped_ct = true;        ///< warped_ct.nii.gz
+  bool warped_ct_dicom = true;  ///< warped_ct_dicom/ series (new UIDs, patient/study copied)
+  bool fields = true;           ///< model_labels.nii.gz and per-element fields as NIfTI
 };
 
 struct Scene {

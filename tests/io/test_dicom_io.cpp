@@ -124,10 +124,9 @@ std::string error_of(Body&& body) {
 ImageVolume oblique_volume(int slices = 6) {
   ImageVolume v;
   v.dims = {12, 9, slices};
-  const Eigen::Matrix3d rotation =
-      (Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitX()))
-          .toRotationMatrix();
+  const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()) *
+                                    Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitX()))
+                                       .toRotationMatrix();
   const Eigen::Vector3d spacing_m(0.7e-3, 0.9e-3, 2.5e-3);
   v.affine_lps_m.topLeftCorner<3, 3>() = rotation * spacing_m.asDiagonal();
   v.affine_lps_m.topRightCorner<3, 1>() = Eigen::Vector3d(-0.1234567, 0.0456789, 0.2101010);
@@ -137,7 +136,7 @@ ImageVolume oblique_volume(int slices = 6) {
       for (int i = 0; i < v.dims[0]; ++i)
         v.values[v.linear_index(i, j, k)] = float(-1000 + 37 * i - 11 * j + 53 * k + 0.3 * (i % 3));
   v.modality = "CT";
-  v.dicom_tags = {{"0010,0010", "Doe^Jane"},       {"0010,0020", "P123"},
+  v.dicom_tags = {{"0010,0010", "Doe^Jane"},      {"0010,0020", "P123"},
                   {"0020,000D", "1.2.826.0.1.1"}, {"0020,0052", "1.2.826.0.1.2"},
                   {"0008,0020", "20240102"},      {"source_series_uid", "1.2.826.0.1.3"}};
   return v;
@@ -145,15 +144,14 @@ ImageVolume oblique_volume(int slices = 6) {
 
 std::vector<float> rounded(const std::vector<float>& values) {
   std::vector<float> out(values.size());
-  std::transform(values.begin(), values.end(), out.begin(),
-                 [](float v) { return std::round(v); });
+  std::transform(values.begin(), values.end(), out.begin(), [](float v) { return std::round(v); });
   return out;
 }
 
 void expect_same_volume(const ImageVolume& a, const ImageVolume& b) {
   EXPECT_EQ(a.dims, b.dims);
   EXPECT_TRUE(a.affine_lps_m.isApprox(b.affine_lps_m, 1e-12)) << a.affine_lps_m << "\n\n"
-                                                             << b.affine_lps_m;
+                                                              << b.affine_lps_m;
   EXPECT_EQ(a.values, b.values);
 }
 
@@ -222,8 +220,8 @@ TEST(DicomRead, CtSmallMatchesPydicom) {
 /// give equal volumes; its JPEG 2000 copy has no decoder in DCMTK and must be refused by name.
 TEST(DicomRead, PydicomCompressedSamplesDecodeAlike) {
   const std::vector<std::string> names = {
-      "MR_small.dcm",          "MR_small_RLE.dcm",          "MR_small_jpeg_ls_lossless.dcm",
-      "MR_small_implicit.dcm", "MR_small_bigendian.dcm",    "MR_small_jp2klossless.dcm"};
+      "MR_small.dcm",          "MR_small_RLE.dcm",       "MR_small_jpeg_ls_lossless.dcm",
+      "MR_small_implicit.dcm", "MR_small_bigendian.dcm", "MR_small_jp2klossless.dcm"};
   const std::size_t readable = names.size() - 1;
   for (const auto& name : names)
     if (!fs::exists(kPydicomData / name)) GTEST_SKIP() << "missing " << kPydicomData / name;
@@ -255,7 +253,8 @@ TEST_F(DicomSeriesTest, RoundTripKeepsGeometryValuesAndStudy) {
   const ImageVolume back = read_dicom_series(series_.string());
   EXPECT_EQ(back.dims, volume_.dims);
   EXPECT_LT((back.affine_lps_m - volume_.affine_lps_m).cwiseAbs().maxCoeff(), 1e-6)
-      << back.affine_lps_m << "\n\n" << volume_.affine_lps_m;
+      << back.affine_lps_m << "\n\n"
+      << volume_.affine_lps_m;
   EXPECT_EQ(back.values, rounded(volume_.values));
   EXPECT_EQ(back.modality, "CT");
   for (const char* key : {"0010,0010", "0010,0020", "0020,000D", "0020,0052", "0008,0020"})
@@ -300,7 +299,8 @@ TEST_F(DicomSeriesTest, PydicomSeesUidsPatientAndPositions) {
     EXPECT_EQ(at(2), "P123");
     const int k = std::stoi(at(3)) - 1;
     const Eigen::Vector3d expected_mm = volume_.world_of_index({0, 0, double(k)}) * 1e3;
-    EXPECT_LT((Eigen::Vector3d(num(4), num(5), num(6)) - expected_mm).norm(), 1e-6) << "slice " << k;
+    EXPECT_LT((Eigen::Vector3d(num(4), num(5), num(6)) - expected_mm).norm(), 1e-6)
+        << "slice " << k;
     EXPECT_LT((Eigen::Vector3d(num(7), num(8), num(9)) - row_direction).norm(), 1e-9);
     EXPECT_NEAR(num(10), 0.9, 1e-12) << "PixelSpacing[0] is the row spacing (along j)";
     EXPECT_NEAR(num(11), 0.7, 1e-12) << "PixelSpacing[1] is the column spacing (along i)";
@@ -356,7 +356,8 @@ TEST_F(DicomSeriesTest, TwoSeriesNeedAChoice) {
   write_dicom_series(other.string(), oblique_volume(3), "second");
   const fs::path mixed = tmp_ / "mixed";
   copy_folder(series_, mixed);
-  for (const auto& file : files_in(other)) fs::copy_file(file, mixed / ("b" + file.filename().string()));
+  for (const auto& file : files_in(other))
+    fs::copy_file(file, mixed / ("b" + file.filename().string()));
 
   const auto series = list_dicom_series(mixed.string());
   ASSERT_EQ(series.size(), 2u);
@@ -426,6 +427,7 @@ TEST_F(DicomSeriesTest, ReencodedSeriesReadAlike) {
       {"jpeg_ls", "dcmcjpls +el"},        // JPEG-LS lossless
       {"rle", "dcmcrle"},
       {"big_endian", "dcmconv +tb"},
+      {"deflated", "dcmconv +td"},
       {"implicit_bare", "dcmconv +ti -F"}};
   for (const auto& [name, command] : encodings) {
     const std::string tool = command.substr(0, command.find(' '));
@@ -433,8 +435,8 @@ TEST_F(DicomSeriesTest, ReencodedSeriesReadAlike) {
     const fs::path encoded = tmp_ / name;
     fs::create_directories(encoded);
     for (const auto& file : files_in(series_))
-      ASSERT_EQ(run_command(command + " " + quoted(file) + " " +
-                            quoted(encoded / file.filename()) + " 2>&1")
+      ASSERT_EQ(run_command(command + " " + quoted(file) + " " + quoted(encoded / file.filename()) +
+                            " 2>&1")
                     .exit_code,
                 0)
           << command;

@@ -104,11 +104,12 @@ class NiftiIo : public ::testing::Test {
     std::string name = std::string(info->test_suite_name()) + "-" + info->name();
     for (char& c : name)
       if (c == '/') c = '_';
-    dir_ = fs::temp_directory_path() / ("voxbreast-nifti-" + std::to_string(::getpid()) + "-" + name);
+    dir_ =
+        fs::temp_directory_path() / ("voxbreast-nifti-" + std::to_string(::getpid()) + "-" + name);
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
-  void TearDown() override { if (!getenv("KEEP")) fs::remove_all(dir_); }
+  void TearDown() override { fs::remove_all(dir_); }
 
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
@@ -205,11 +206,11 @@ bool nibabel_available() {
   return available;
 }
 
-#define REQUIRE_NIBABEL()                                                      \
-  do {                                                                         \
-    if (!nibabel_available())                                                  \
+#define REQUIRE_NIBABEL()                                                        \
+  do {                                                                           \
+    if (!nibabel_available())                                                    \
       GTEST_SKIP() << "/usr/bin/python3 cannot import nibabel; install it with " \
-                      "scripts/setup.sh (python3-nibabel)";                    \
+                      "scripts/setup.sh (python3-nibabel)";                      \
   } while (0)
 
 /// Runs a Python script with arguments; returns its stdout, failing the test on a non-zero exit.
@@ -510,8 +511,9 @@ TEST_F(NiftiIo, WriteErrorsLeaveNoFile) {
   expect_error([&] { write_nifti_displacement(path("u.nii"), image, u); }, path("u.nii"),
                "3 per voxel");
   const std::string nowhere = path("no/such/folder/x.nii");
-  expect_error([&] { write_nifti(nowhere, oblique_volume(NiftiType::Float32), NiftiType::Float32); },
-               nowhere, "cannot create");
+  expect_error(
+      [&] { write_nifti(nowhere, oblique_volume(NiftiType::Float32), NiftiType::Float32); },
+      nowhere, "cannot create");
   EXPECT_TRUE(fs::is_empty(dir_));
 }
 
@@ -524,8 +526,8 @@ TEST_F(NiftiIo, NibabelSeesOurScalarFile) {
   auto seen = parse_lines(run_python(dir_, kNibabelDump, path("ct.nii.gz") + " 0 0 0 4 3 2 1 2 1"));
 
   EXPECT_EQ(seen["shape"], (std::vector<double>{5, 4, 3}));
-  EXPECT_EQ(seen["codes"], (std::vector<double>{1, 1}));       // sform, qform: scanner
-  EXPECT_EQ(seen["xyzt_units"], (std::vector<double>{2}));     // mm
+  EXPECT_EQ(seen["codes"], (std::vector<double>{1, 1}));    // sform, qform: scanner
+  EXPECT_EQ(seen["xyzt_units"], (std::vector<double>{2}));  // mm
   EXPECT_EQ(seen["nifti2"], (std::vector<double>{0}));
   const Eigen::Matrix4d expected = ras_mm(image.affine_lps_m);
   expect_affine_near(as_matrix(seen["affine"]), expected, 1e-4);  // mm
