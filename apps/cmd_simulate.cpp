@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "apps/commands.hpp"
+#include "apps/image_outputs.hpp"
 #include "apps/progress.hpp"
 #include "apps/simulation_setup.hpp"
 #include "engine/sim/run.hpp"
@@ -41,12 +42,19 @@ int run_simulate(const SimulateOptions& o) {
 
   const std::string h5 = o.out + "/result.h5", json = o.out + "/summary.json";
   write_result_h5(h5, model.lattice, scene, result.state, result.frames, result.summary);
-  write_summary_json(json, result.summary, scene);
+  nlohmann::json summary = summary_to_json(result.summary, scene);
+  if (model.ct) {
+    summary["image_outputs"] = write_image_outputs(o.out, scene, model.lattice, *model.ct, result.state);
+    summary["warnings"] = model.warnings;
+  }
+  write_text_atomically(json, summary.dump(2) + "\n");
   const RunSummary& s = result.summary;
   std::printf("%s after %lld steps (%.4g s simulated, %.1f s wall, %.0f steps/s); max displacement %.3f mm\n",
               s.converged ? "equilibrium reached" : ("stopped at " + s.stop_reason).c_str(), (long long)s.steps,
               s.simulated_time_s, s.wall_time_s, s.steps_per_second, 1e3 * s.max_displacement_m);
+  for (const std::string& w : model.warnings) std::fprintf(stderr, "voxbreast: warning: %s\n", w.c_str());
   std::printf("wrote %s\nwrote %s\n", json.c_str(), h5.c_str());
+  if (model.ct) std::printf("wrote DVF, warped CT and fields on the CT grid in %s/\n", o.out.c_str());
   return 0;
 }
 

@@ -14,5 +14,6 @@ struct Command {
 Command add_info(CLI::App& app);
 Command add_simulate(CLI::App& app);
 Command add_bench(CLI::App& app);
+Command add_phantom(CLI::App& app);
 
 }  // namespace vb::app

@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string(vb::config::version) + " (" + vb::config::git_commit + ")");
   app.require_subcommand(1);
   const vb::app::Command commands[] = {vb::app::add_info(app), vb::app::add_simulate(app),
-                                       vb::app::add_bench(app)};
+                                       vb::app::add_bench(app), vb::app::add_phantom(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,7 +1,10 @@
 #pragma once
 /// Scene → model steps shared by the subcommands.
+#include <optional>
 #include <string>
+#include <vector>
 
+#include "engine/image/image_volume.hpp"
 #include "engine/lattice/lattice.hpp"
 #include "engine/scene/scene.hpp"
 #include "engine/sim/element_setup.hpp"
@@ -14,9 +17,14 @@ Scene load_scene(const std::string& path, const std::string& precision);
 struct PreparedModel {
   Lattice lattice;
   ElementArrays elements;
+  std::optional<ImageVolume> ct;      ///< the input CT, for image models
+  std::vector<std::string> warnings;  ///< e.g. DICOM slice gaps accepted with allow_gaps
 };
 
-/// Voxelises the shapes, builds the lattice and the per-element arrays.
+/// Reads a CT: a folder is a DICOM series, a file is NIfTI.
+ImageVolume load_ct(const ModelSpec& model, std::vector<std::string>& warnings);
+
+/// Builds the lattice from shapes or from the CT (+ labels) and the per-element arrays.
 PreparedModel prepare_model(const Scene& scene);
 
 }  // namespace vb::app
