@@ -31,6 +31,9 @@ std::string phantom_scene(const Phantom& p, const PhantomSpec& spec) {
     << "]\n\n[model.label_table]\n";
   for (std::size_t v = 1; v < p.label_names.size(); ++v) s << v << " = \"" << p.label_names[v] << "\"\n";
   s << "\n[materials.muscle]\nrigid = true  # the chest wall holds the breast\n"
+    << "\n# At a 4 mm lattice the ~2 mm skin becomes a 4 mm layer: halve its default modulus so its\n"
+    << "# membrane stiffness E·t stays that of a 2 mm skin (docs/MATERIALS.md).\n"
+    << "[materials.skin]\nE = 40000.0\n"
     << "\n[solver]\nintegrator = \"heun\"\ndamping = 40.0\ndashpot_ratio = 0.1\n"
     << "\n[gravity]\nposture = \"prone\"\n";
   for (std::size_t t = 0; t < spec.tumours.size(); ++t) {

@@ -33,6 +33,26 @@ else fail "sample scene"; cat "$work/sample.txt"; fi
 h5dump -H "$work/sample/result.h5" >"$work/h5.txt" 2>&1
 if grep -q '"displacement_m"' "$work/h5.txt"; then pass "result.h5 readable"; else fail "result.h5"; fi
 
+# --- the main job: the bundled phantom CT (DICOM) to DVF, warped CT and summary
+if "$bin" simulate "$root/data-samples/phantom/scene_dicom.toml" --out "$work/ct" --quiet >"$work/ct.txt" 2>&1 \
+   && /usr/bin/python3 - "$work/ct" <<'PY'
+import json, sys, nibabel as nib, numpy as np
+d = sys.argv[1]
+s = json.load(open(d + "/summary.json"))
+assert s["converged"], s["stop_reason"]
+dvf = nib.load(d + "/dvf.nii.gz")
+assert dvf.shape[3:] == (1, 3) and dvf.header.get_intent()[0] == "displacement vector", dvf.header.get_intent()
+u = np.asarray(dvf.dataobj)
+assert np.abs(u).max() > 0.5, "a prone breast moves by more than half a millimetre"  # mm
+w = nib.load(d + "/warped_ct.nii.gz")
+assert w.shape == dvf.shape[:3]
+t = s["tracked"]["tumour_1"]["displacement_m"]
+assert t[1] < 0, t  # prone: anteriorly
+PY
+then pass "CT phantom (DICOM) → summary, DVF, warped CT"
+else fail "CT phantom"; cat "$work/ct.txt"; fi
+if dcmdump "$work/ct/warped_ct_dicom/CT00001.dcm" >/dev/null 2>&1; then pass "warped CT DICOM readable by dcmdump"; else fail "warped CT DICOM"; fi
+
 # --- bad input: each must fail with one 'voxbreast: error:' line naming the problem, and no result.h5
 scene() {  # base scene: a small block on a held base
   cat <<TOML
@@ -78,6 +98,14 @@ expect_error no_elements "no elements" "$(scene | sed 's/^max = \[0.01, 0.01, 0.
 expect_error unstable "unstable at step" "$(scene; printf '[solver]\nintegrator = "symplectic_euler"\ndt = 0.01\n')"
 expect_error unwritable_output "cannot write to output folder" "$(scene)" /proc/voxbreast-not-writable
 expect_error missing_material "soft" "$(scene | sed 's/^\[materials.soft\]/[materials.other]/')"
+
+# A corrupt CT: the phantom scene with a truncated ct.nii.gz
+mkdir -p "$work/corrupt" && cp "$root/data-samples/phantom/labels.nii.gz" "$root/data-samples/phantom/scene.toml" "$work/corrupt/"
+head -c 2000 "$root/data-samples/phantom/ct.nii.gz" >"$work/corrupt/ct.nii.gz"
+if ! "$bin" simulate "$work/corrupt/scene.toml" --out "$work/corrupt/out" --quiet 2>"$work/corrupt.err" \
+   && grep -q "^voxbreast: error:.*ct.nii.gz" "$work/corrupt.err" && [[ ! -e "$work/corrupt/out/result.h5" ]]; then
+  pass "truncated CT: $(cat "$work/corrupt.err")"
+else fail "truncated CT"; cat "$work/corrupt.err"; fi
 
 echo "$passes passed, $failures failed"
 [[ $failures -eq 0 ]]
