@@ -16,12 +16,14 @@ namespace vb::app {
 namespace {
 
 struct SimulateOptions {
-  std::string scene, out, device, precision;
-  bool quiet = false;
+  std::string scene, out, device, precision, series;
+  bool quiet = false, allow_gaps = false;
 };
 
 int run_simulate(const SimulateOptions& o) {
   Scene scene = load_scene(o.scene, o.precision);
+  if (!o.series.empty()) scene.model.series_uid = o.series;
+  scene.model.allow_gaps = scene.model.allow_gaps || o.allow_gaps;
   ensure_output_dir(o.out);  // fail before computing, not after
   const PreparedModel model = prepare_model(scene);
   const ClContext cl(select_device(o.device));
@@ -67,6 +69,8 @@ Command add_simulate(CLI::App& app) {
   sub->add_option("--out,-o", o->out, "output folder")->required();
   sub->add_option("--device,-d", o->device, "OpenCL device: gpu, cpu, an index or a name (default $VOXBREAST_DEVICE, else first GPU)");
   sub->add_option("--precision", o->precision, "override solver.precision")->check(CLI::IsMember({"float", "double"}));
+  sub->add_option("--series", o->series, "DICOM SeriesInstanceUID when the CT folder holds several series");
+  sub->add_flag("--allow-gaps", o->allow_gaps, "accept unevenly spaced DICOM slices (with a warning)");
   sub->add_flag("--quiet,-q", o->quiet, "no progress display");
   return {sub, [o] { return run_simulate(*o); }};
 }

@@ -59,6 +59,21 @@ std::vector<std::uint8_t> tissues_from_hu(const ModelSpec& model, const ImageVol
   return out;
 }
 
+/// Renumbers tissues so only those with voxels keep a name (dropped ones then need no material).
+void drop_unused_tissues(TissueMap& map) {
+  std::vector<std::size_t> count(map.tissue_names.size() + 1, 0);
+  for (std::uint8_t t : map.tissue) ++count[t];
+  std::vector<std::uint8_t> renumber(count.size(), 0);
+  std::vector<std::string> names;
+  for (std::size_t t = 1; t < count.size(); ++t)
+    if (count[t]) {
+      names.push_back(map.tissue_names[t - 1]);
+      renumber[t] = static_cast<std::uint8_t>(names.size());
+    }
+  for (std::uint8_t& t : map.tissue) t = renumber[t];
+  map.tissue_names = std::move(names);
+}
+
 }  // namespace
 
 TissueMap classify_image(const ModelSpec& model, const ImageVolume& ct, const ImageVolume* labels) {
@@ -95,6 +110,7 @@ TissueMap classify_image(const ModelSpec& model, const ImageVolume& ct, const Im
       }
   require(modelled > 0, "no CT voxel is classified as a modelled tissue", "model",
           "check the label table / HU classes, model.keep and the ROI");
+  drop_unused_tissues(map);
   return map;
 }
 

@@ -51,6 +51,17 @@ assert t[1] < 0, t  # prone: anteriorly
 PY
 then pass "CT phantom (DICOM) → summary, DVF, warped CT"
 else fail "CT phantom"; cat "$work/ct.txt"; fi
+# The same CT as NIfTI must give the same result as the DICOM series.
+if "$bin" simulate "$root/data-samples/phantom/scene.toml" --out "$work/ct_nifti" --quiet >/dev/null 2>&1 \
+   && python3 - "$work/ct/summary.json" "$work/ct_nifti/summary.json" <<'PY'
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:3])
+assert a["elements"] == b["elements"] and a["steps"] == b["steps"], (a["elements"], b["elements"])
+ua, ub = a["tracked"]["tumour_1"]["displacement_m"], b["tracked"]["tumour_1"]["displacement_m"]
+assert max(abs(x - y) for x, y in zip(ua, ub)) < 1e-9, (ua, ub)
+PY
+then pass "NIfTI and DICOM inputs give the same result"
+else fail "NIfTI vs DICOM"; fi
 if dcmdump "$work/ct/warped_ct_dicom/CT00001.dcm" >/dev/null 2>&1; then pass "warped CT DICOM readable by dcmdump"; else fail "warped CT DICOM"; fi
 
 # --- bad input: each must fail with one 'voxbreast: error:' line naming the problem, and no result.h5
