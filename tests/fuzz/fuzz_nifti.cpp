@@ -1,0 +1,123 @@
+/// libFuzzer target: vb::read_nifti (and vb::read_nifti_displacement) on arbitrary file contents.
+/// Built and run by scripts/fuzz.sh; seeds in tests/fuzz/corpus/nifti/.
+///
+/// Input layout: byte 0 is a flag byte, the rest is the payload.
+///   flag & 3 == 0 (or 3): the payload is written as `<tmp>/input.nii`
+///   flag & 3 == 1:        the payload is gzip-compressed here and written as `input.nii.gz`
+///                         (the fuzzer's mutations reach the NIfTI parser through znzlib's gzip path)
+///   flag & 3 == 2:        the payload is written as-is as `input.nii.gz` (corrupt/raw gzip streams)
+///   flag & 4:             also call read_nifti_displacement on the same file
+/// vb::Error is the expected outcome for bad input; any other exception, a crash or a sanitizer
+/// report is a finding.
+#include <unistd.h>
+#include <zlib.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "engine/error.hpp"
+#include "io/nifti_io.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// One private folder per process under $TMPDIR (or /tmp), removed at exit.
+const fs::path& work_dir() {
+  static const fs::path dir = [] {
+    const char* base = std::getenv("TMPDIR");
+    std::string pattern = std::string(base && *base ? base : "/tmp") + "/vb-fuzz-nifti-XXXXXX";
+    if (!::mkdtemp(pattern.data())) {
+      std::perror("fuzz_nifti: mkdtemp");
+      std::abort();
+    }
+    std::atexit([] {
+      std::error_code ignored;
+      fs::remove_all(work_dir(), ignored);
+    });
+    return fs::path(pattern);
+  }();
+  return dir;
+}
+
+void write_plain(const fs::path& path, const std::uint8_t* data, std::size_t size) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
+  if (!out) {
+    std::fprintf(stderr, "fuzz_nifti: cannot write %s\n", path.c_str());
+    std::abort();
+  }
+}
+
+void write_gzip(const fs::path& path, const std::uint8_t* data, std::size_t size) {
+  gzFile out = gzopen(path.c_str(), "wb1");
+  const bool ok = out != nullptr && (size == 0 || gzwrite(out, data, unsigned(size)) == int(size));
+  if (!ok || gzclose(out) != Z_OK) {
+    std::fprintf(stderr, "fuzz_nifti: cannot write %s\n", path.c_str());
+    std::abort();
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return 0;
+  const std::uint8_t flag = data[0];
+  const std::uint8_t* payload = data + 1;
+  const std::size_t payload_size = size - 1;
+
+  const fs::path plain = work_dir() / "input.nii";
+  const fs::path gzip = work_dir() / "input.nii.gz";
+  // Only the file of this input exists, so a run never depends on the previous input.
+  std::error_code ignored;
+  fs::remove(plain, ignored);
+  fs::remove(gzip, ignored);
+
+  fs::path path;
+  switch (flag & 3) {
+    case 1: path = gzip; write_gzip(path, payload, payload_size); break;
+    case 2: path = gzip; write_plain(path, payload, payload_size); break;
+    default: path = plain; write_plain(path, payload, payload_size); break;
+  }
+
+  try {
+    const vb::ImageVolume image = vb::read_nifti(path.string());
+    // What the reader promises: one value per voxel of a non-empty grid.
+    if (image.values.size() != image.voxel_count() || image.voxel_count() == 0) {
+      std::fprintf(stderr, "fuzz_nifti: read_nifti returned %zu values for %zu voxels\n",
+                   image.values.size(), image.voxel_count());
+      std::abort();
+    }
+  } catch (const vb::Error&) {
+    // expected for bad input
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fuzz_nifti: read_nifti threw a non-vb::Error exception: %s\n", e.what());
+    std::abort();
+  }
+
+  if (flag & 4) {
+    try {
+      std::vector<float> displacement;
+      const vb::ImageVolume grid = vb::read_nifti_displacement(path.string(), displacement);
+      if (displacement.size() != 3 * grid.voxel_count()) {
+        std::fprintf(stderr, "fuzz_nifti: read_nifti_displacement returned %zu floats for %zu "
+                     "voxels\n", displacement.size(), grid.voxel_count());
+        std::abort();
+      }
+    } catch (const vb::Error&) {
+    } catch (const std::exception& e) {
+      std::fprintf(stderr,
+                   "fuzz_nifti: read_nifti_displacement threw a non-vb::Error exception: %s\n",
+                   e.what());
+      std::abort();
+    }
+  }
+  return 0;
+}
