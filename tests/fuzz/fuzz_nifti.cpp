@@ -8,7 +8,8 @@
 ///   flag & 3 == 2:        the payload is written as-is as `input.nii.gz` (corrupt/raw gzip streams)
 ///   flag & 4:             also call read_nifti_displacement on the same file
 /// vb::Error is the expected outcome for bad input; any other exception, a crash or a sanitizer
-/// report is a finding.
+/// report is a finding. With VB_FUZZ_VERBOSE=1 in the environment each call's outcome is printed
+/// (for replaying single inputs: VB_FUZZ_VERBOSE=1 build/fuzz/fuzz_nifti FILE).
 #include <unistd.h>
 #include <zlib.h>
 
@@ -28,6 +29,11 @@
 namespace fs = std::filesystem;
 
 namespace {
+
+bool verbose() {
+  static const bool on = std::getenv("VB_FUZZ_VERBOSE") != nullptr;
+  return on;
+}
 
 /// One private folder per process under $TMPDIR (or /tmp), removed at exit.
 const fs::path& work_dir() {
@@ -95,8 +101,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                    image.values.size(), image.voxel_count());
       std::abort();
     }
-  } catch (const vb::Error&) {
-    // expected for bad input
+    if (verbose())
+      std::fprintf(stderr, "read_nifti %s: %dx%dx%d voxels, modality '%s'\n", path.c_str(),
+                   image.dims[0], image.dims[1], image.dims[2], image.modality.c_str());
+  } catch (const vb::Error& e) {
+    if (verbose()) std::fprintf(stderr, "read_nifti: vb::Error: %s\n", e.what());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fuzz_nifti: read_nifti threw a non-vb::Error exception: %s\n", e.what());
     std::abort();
@@ -111,7 +120,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                      "voxels\n", displacement.size(), grid.voxel_count());
         std::abort();
       }
-    } catch (const vb::Error&) {
+      if (verbose())
+        std::fprintf(stderr, "read_nifti_displacement: %dx%dx%d voxels\n", grid.dims[0],
+                     grid.dims[1], grid.dims[2]);
+    } catch (const vb::Error& e) {
+      if (verbose()) std::fprintf(stderr, "read_nifti_displacement: vb::Error: %s\n", e.what());
     } catch (const std::exception& e) {
       std::fprintf(stderr,
                    "fuzz_nifti: read_nifti_displacement threw a non-vb::Error exception: %s\n",

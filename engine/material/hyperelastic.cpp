@@ -1,0 +1,130 @@
+#include "engine/material/hyperelastic.hpp"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+#include "engine/error.hpp"
+
+namespace vb {
+
+double HyperelasticLaw::shear_modulus_pa() const {
+  double mu0 = 0;
+  for (int p = 0; p < terms; ++p) mu0 += 0.5 * mu_pa[p] * alpha[p];
+  return mu0;
+}
+
+double HyperelasticLaw::youngs_modulus_pa() const {
+  const double mu0 = shear_modulus_pa(), k = bulk_modulus_pa;
+  return 9 * k * mu0 / (3 * k + mu0);
+}
+
+double HyperelasticLaw::poisson_ratio() const {
+  const double mu0 = shear_modulus_pa(), k = bulk_modulus_pa;
+  return (3 * k - 2 * mu0) / (2 * (3 * k + mu0));
+}
+
+double HyperelasticLaw::p_wave_modulus_pa() const { return bulk_modulus_pa + 4.0 / 3.0 * shear_modulus_pa(); }
+
+double bulk_modulus_from(double mu, double nu) {
+  require(nu > -1 && nu < 0.5, "Poisson's ratio must lie in (−1, 0.5)", "nu", "use e.g. 0.45–0.499 for tissue");
+  return 2 * mu * (1 + nu) / (3 * (1 - 2 * nu));
+}
+
+HyperelasticLaw neo_hookean_from_E_nu(double E, double nu) {
+  require(E > 0 && std::isfinite(E), "Young's modulus must be positive", "E");
+  HyperelasticLaw law;
+  law.kind = HyperelasticLaw::Kind::NeoHookean;
+  law.terms = 1;
+  law.mu_pa = {E / (2 * (1 + nu)), 0, 0};
+  law.alpha = {2, 0, 0};
+  law.bulk_modulus_pa = bulk_modulus_from(law.mu_pa[0], nu);
+  return law;
+}
+
+HyperelasticLaw mooney_rivlin(double c10, double c01, double kappa) {
+  HyperelasticLaw law;
+  law.kind = HyperelasticLaw::Kind::MooneyRivlin;
+  law.terms = 2;
+  law.mu_pa = {2 * c10, -2 * c01, 0};
+  law.alpha = {2, -2, 0};
+  law.bulk_modulus_pa = kappa;
+  require(law.shear_modulus_pa() > 0, "C10 + C01 must be positive", "c10");
+  require(kappa > 0, "bulk modulus must be positive", "bulk_modulus");
+  return law;
+}
+
+HyperelasticLaw ogden(const std::vector<double>& mu, const std::vector<double>& alpha, double kappa) {
+  require(mu.size() >= 1 && mu.size() <= 3 && mu.size() == alpha.size(),
+          "Ogden needs 1 to 3 terms with one mu and one alpha each", "mu");
+  HyperelasticLaw law;
+  law.kind = HyperelasticLaw::Kind::Ogden;
+  law.terms = int(mu.size());
+  for (std::size_t p = 0; p < mu.size(); ++p) {
+    require(alpha[p] != 0 && std::isfinite(alpha[p]) && std::isfinite(mu[p]), "alpha must be nonzero and finite", "alpha");
+    law.mu_pa[p] = mu[p];
+    law.alpha[p] = alpha[p];
+  }
+  require(law.shear_modulus_pa() > 0, "the initial shear modulus ½Σμ_pα_p must be positive", "mu");
+  require(kappa > 0, "bulk modulus must be positive", "bulk_modulus");
+  law.bulk_modulus_pa = kappa;
+  return law;
+}
+
+namespace {
+
+/// Principal stretches λ_i and material directions N_i (columns) of C = FᵀF.
+void principal_stretches(const Eigen::Matrix3d& F, Eigen::Vector3d& stretch, Eigen::Matrix3d& N) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(F.transpose() * F);
+  stretch = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  N = eig.eigenvectors();
+}
+
+}  // namespace
+
+double strain_energy(const HyperelasticLaw& law, const Eigen::Matrix3d& F) {
+  Eigen::Vector3d l;
+  Eigen::Matrix3d N;
+  principal_stretches(F, l, N);
+  const double J = F.determinant();
+  const Eigen::Vector3d lb = l * std::pow(J, -1.0 / 3.0);
+  double W = 0.5 * law.bulk_modulus_pa * (J - 1) * (J - 1);
+  for (int p = 0; p < law.terms; ++p)
+    W += law.mu_pa[p] / law.alpha[p] * (lb.array().pow(law.alpha[p]).sum() - 3);
+  return W;
+}
+
+Eigen::Matrix3d first_piola(const HyperelasticLaw& law, const Eigen::Matrix3d& F) {
+  Eigen::Vector3d l;
+  Eigen::Matrix3d N;
+  principal_stretches(F, l, N);
+  const double J = F.determinant();
+  const Eigen::Vector3d lb = l * std::pow(J, -1.0 / 3.0);
+  // Principal Kirchhoff stresses τ_i = λ_i ∂W/∂λ_i: deviatoric Ogden part + volumetric κJ(J−1).
+  Eigen::Vector3d tau = Eigen::Vector3d::Constant(law.bulk_modulus_pa * J * (J - 1));
+  for (int p = 0; p < law.terms; ++p) {
+    const Eigen::Vector3d la = lb.array().pow(law.alpha[p]);
+    tau += law.mu_pa[p] * (la.array() - la.sum() / 3.0).matrix();
+  }
+  // Second Piola-Kirchhoff S = Σ τ_i/λ_i² N_i N_iᵀ, then P = F S.
+  const Eigen::Matrix3d S = N * tau.cwiseQuotient(l.cwiseProduct(l)).asDiagonal() * N.transpose();
+  return F * S;
+}
+
+double uniaxial_nominal_stress(const HyperelasticLaw& law, double stretch) {
+  double P = 0;
+  for (int p = 0; p < law.terms; ++p)
+    P += law.mu_pa[p] * (std::pow(stretch, law.alpha[p] - 1) - std::pow(stretch, -law.alpha[p] / 2 - 1));
+  return P;
+}
+
+double simple_shear_stress(const HyperelasticLaw& law, double gamma) {
+  // In-plane principal stretches of F = I + γ e1⊗e2: λ1,2 = √(1 + γ²/4) ± γ/2, λ3 = 1; the
+  // principal axes make angle θ with tan 2θ = 2/γ, so σ12 = (σ1 − σ2) sin 2θ / 2.
+  const double s = std::sqrt(1 + gamma * gamma / 4), l1 = s + gamma / 2, l2 = s - gamma / 2;
+  double diff = 0;
+  for (int p = 0; p < law.terms; ++p) diff += law.mu_pa[p] * (std::pow(l1, law.alpha[p]) - std::pow(l2, law.alpha[p]));
+  const double sin2theta = 2 / std::sqrt(4 + gamma * gamma);
+  return 0.5 * diff * sin2theta;
+}
+
+}  // namespace vb
