@@ -26,7 +26,7 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
     bad = finite ? 0 : 1;
     disp = finite ? length(xyz0(ui)) : 0;
     if (finite && ui.w != 0) {
-      real4 f = static_force(e, ui, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity);
+      real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
 #if VB_INDENTER
       const real4 x = rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui);
       reaction = contact_constrain(&f, x, ind_force_pos, ind_normal, ind_radius, h);

@@ -3,6 +3,7 @@
 //   -DVB_GRAVITY=0|1, -DVB_DASHPOT=0|1, -DVB_GLOBAL_DAMPING=0|1, -DVB_INDENTER=0|1
 //                     so only what the scene uses is compiled
 //   -DVB_RSQRT=0|1    1/|r| by rsqrt (GPUs) or 1/sqrt (CPUs, where rsqrt is a library call)
+//   -DVB_HYPER=0|1    hyperelastic tissues present (kernels/hyperelastic.cl)
 //   -DVB_CHECK_WG=N   work-group size of the reduction kernel
 // and prepends the lattice tables (VB_DIR, VB_DIR_LEN, VB_KAPPA) generated from the host's
 // single definition (engine/sim/kernel_tables.cpp).
@@ -32,10 +33,15 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
 #define REAL_CONTACT_TOL ((real)1e-3)
 
 // Parameters every stepping kernel takes, in this order (the host sets them in one place).
-#define VB_LATTICE_PARAMS                                                                      \
-  global const real *E, global const uint *cell_of, global const int *grid, int sy, int sz,  \
-      real h, real dashpot_ratio, real4 gravity, real damping, real4 origin
-#define VB_LATTICE_ARGS E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity, damping, origin
+// Hyperelastic data (tissue_of, materials, Qs, Fs, hourglass) are 1-element placeholders when
+// VB_HYPER is 0.
+#define VB_LATTICE_PARAMS                                                                        \
+  global const real *E, global const uint *cell_of, global const int *grid, int sy, int sz,    \
+      real h, real dashpot_ratio, real4 gravity, real damping, real4 origin,                   \
+      global const uchar *tissue_of, global const real *materials, global const real4 *Qs,     \
+      global const real4 *Fs, real hourglass
+#define VB_LATTICE_ARGS \
+  E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity, damping, origin, tissue_of, materials, Qs, Fs, hourglass
 // Indenter: position where forces are evaluated, position for the end-of-stage projection,
 // plate normal, velocity, radius (< 0: plate). Ignored when VB_INDENTER is 0.
 #define VB_INDENTER_PARAMS \

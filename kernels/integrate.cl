@@ -6,7 +6,7 @@
 
 inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
                           VB_LATTICE_PARAMS, real4 ind_pos, real4 ind_normal, real ind_radius) {
-  real4 f = static_force(e, ui, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity);
+  real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
 #if VB_GLOBAL_DAMPING
   f -= damping * xyz0(vi) / ui.w;
 #endif

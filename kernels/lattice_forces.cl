@@ -4,13 +4,21 @@
 // A connection's stiffness is k = κ_d · h · E_ij, where κ_d is the direction class's coefficient
 // (docs/PHYSICS.md) and E_ij = 2·E_i·E_j/(E_i+E_j) joins the two halves in series.
 
+// Force on element e from its connections (N). Linear-spring tissues: springs k = κ_d·h·E_ij.
+// Hyperelastic tissues (VB_HYPER): the element stresses of pass 1 (Q·h·d from each neighbour,
+// Q_e·Σh·d from the element itself) plus hourglass control. Per connection, each end adds half a
+// spring: a linear end ½k(|r| − L), a hyperelastic end c_hg·k(|r| − |F·h·d|), whose rest length is
+// the length its own affine fit predicts, so affine fields feel no hourglass force.
 // u: displacement (m) with w = inverse mass (1/kg, 0 = held); v: velocity (m/s).
-real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                    global const real* E, global const uint* cell_of, global const int* grid,
-                    int sy, int sz, real h, real dashpot_ratio) {
+real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v, VB_LATTICE_PARAMS) {
   const int cell = (int)cell_of[e];
   const real Ei = E[e];
   real4 f = (real4)(0);
+#if VB_HYPER
+  const int law_i = (int)materials[VB_MAT_STRIDE * tissue_of[e]];
+  const mat3 Fi = mat3_load(Fs, e);
+  real4 own_offsets = (real4)(0);
+#endif
 #pragma unroll
   for (int d = 0; d < 26; ++d) {
     // Branch-free: a missing neighbour reads the element itself and is masked out, so CPU
@@ -19,32 +27,45 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
     const real present = jn >= 0 ? (real)1 : (real)0;
     const int j = jn >= 0 ? jn : (int)e;
     const real4 uj = u[j];
-    const real4 r = (real4)(h * VB_DIR[d][0] + (uj.x - ui.x), h * VB_DIR[d][1] + (uj.y - ui.y),
-                            h * VB_DIR[d][2] + (uj.z - ui.z), 0);
+    const real4 hd = (real4)(h * VB_DIR[d][0], h * VB_DIR[d][1], h * VB_DIR[d][2], 0);
+    const real4 r = (real4)(hd.x + (uj.x - ui.x), hd.y + (uj.y - ui.y), hd.z + (uj.z - ui.z), 0);
     const real len_sq = dot3(r, r);
 #if VB_RSQRT
     const real inv_len = rsqrt(len_sq);  // a hardware instruction on GPUs
 #else
     const real inv_len = 1 / sqrt(len_sq);  // PoCL's rsqrt() is a slow library call (3× here)
 #endif
+    const real len = len_sq * inv_len;
     const real4 n = r * inv_len;
     const real Ej = E[j];
     const real k = present * VB_KAPPA[d] * h * (2 * Ei * Ej / (Ei + Ej));
-    real magnitude = k * (len_sq * inv_len - h * VB_DIR_LEN[d]);
+    const real rest = h * VB_DIR_LEN[d];
+#if VB_HYPER
+    const int law_j = (int)materials[VB_MAT_STRIDE * tissue_of[j]];
+    real magnitude = law_i == 0 ? (real)0.5 * k * (len - rest) : hourglass * k * (len - length(mat3_apply(Fi, hd)));
+    magnitude += law_j == 0 ? (real)0.5 * k * (len - rest)
+                            : hourglass * k * (len - length(mat3_apply(mat3_load(Fs, (uint)j), hd)));
+    if (law_j != 0) f += present * mat3_apply(mat3_load(Qs, (uint)j), hd);
+    own_offsets += present * hd;
+#else
+    real magnitude = k * (len - rest);
+#endif
 #if VB_DASHPOT
     const real reduced_mass = 1 / (ui.w + uj.w);
     magnitude += 2 * dashpot_ratio * sqrt(k * reduced_mass) * dot3(v[j] - vi, n);
 #endif
     f += magnitude * n;
   }
+#if VB_HYPER
+  if (law_i != 0) f += mat3_apply(mat3_load(Qs, e), own_offsets);
+#endif
   return f;
 }
 
 // Net force on a free element from the lattice and gravity (N), before contact constraints.
 inline real4 static_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                          global const real* E, global const uint* cell_of, global const int* grid,
-                          int sy, int sz, real h, real dashpot_ratio, real4 gravity) {
-  real4 f = lattice_force(e, ui, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio);
+                          VB_LATTICE_PARAMS) {
+  real4 f = lattice_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
 #if VB_GRAVITY
   f += xyz0(gravity) / ui.w;
 #endif
@@ -91,10 +112,9 @@ inline void contact_project(real4* ui, real4* vi, real4 X, real4 position, real4
 #endif
 
 // Test entry point: lattice forces only (N), for comparison with the host reference.
-kernel void lattice_forces(global const real4* u, global const real4* v, global const real* E,
-                           global const uint* cell_of, global const int* grid, int sy, int sz,
-                           real h, real dashpot_ratio, global real4* f_out, uint n) {
+kernel void lattice_forces(global const real4* u, global const real4* v, VB_LATTICE_PARAMS, global real4* f_out,
+                           uint n) {
   const uint e = get_global_id(0);
   if (e >= n) return;
-  f_out[e] = lattice_force(e, u[e], v[e], u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio);
+  f_out[e] = lattice_force(e, u[e], v[e], u, v, VB_LATTICE_ARGS);
 }

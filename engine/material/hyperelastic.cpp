@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "engine/error.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace vb {
 
@@ -68,6 +69,29 @@ HyperelasticLaw ogden(const std::vector<double>& mu, const std::vector<double>& 
   require(kappa > 0, "bulk modulus must be positive", "bulk_modulus");
   law.bulk_modulus_pa = kappa;
   return law;
+}
+
+HyperelasticLaw law_of(const MaterialSpec& m) {
+  try {
+    if (m.law == "neo-hookean") {
+      HyperelasticLaw law = neo_hookean_from_E_nu(m.youngs_modulus_pa, m.poisson_ratio);
+      if (m.bulk_modulus_pa > 0) law.bulk_modulus_pa = m.bulk_modulus_pa;
+      return law;
+    }
+    if (m.law == "mooney-rivlin") {
+      const double mu0 = 2 * (m.c10_pa + m.c01_pa);
+      return mooney_rivlin(m.c10_pa, m.c01_pa, m.bulk_modulus_pa > 0 ? m.bulk_modulus_pa : bulk_modulus_from(mu0, m.poisson_ratio));
+    }
+    if (m.law == "ogden") {
+      double mu0 = 0;
+      for (std::size_t p = 0; p < m.ogden_mu_pa.size() && p < m.ogden_alpha.size(); ++p) mu0 += 0.5 * m.ogden_mu_pa[p] * m.ogden_alpha[p];
+      require(mu0 > 0, "the initial shear modulus ½Σμ_pα_p must be positive", "mu");
+      return ogden(m.ogden_mu_pa, m.ogden_alpha, m.bulk_modulus_pa > 0 ? m.bulk_modulus_pa : bulk_modulus_from(mu0, m.poisson_ratio));
+    }
+  } catch (const Error& e) {
+    throw Error(e.problem(), "materials." + m.name + (e.location().empty() ? "" : "." + e.location()), e.hint());
+  }
+  throw Error("law '" + m.law + "' is not hyperelastic", "materials." + m.name + ".law");
 }
 
 namespace {

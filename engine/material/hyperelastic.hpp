@@ -6,6 +6,9 @@
 #include <Eigen/Core>
 #include <array>
 #include <string>
+#include <vector>
+
+#include "engine/scene/scene.hpp"
 
 namespace vb {
 
@@ -34,6 +37,10 @@ HyperelasticLaw mooney_rivlin(double c10_pa, double c01_pa, double bulk_modulus_
 HyperelasticLaw ogden(const std::vector<double>& mu_pa, const std::vector<double>& alpha, double bulk_modulus_pa);
 /// Bulk modulus from the initial shear modulus and ν.
 double bulk_modulus_from(double shear_modulus_pa, double poisson_ratio);
+
+/// The law of a hyperelastic material spec (law neo-hookean, mooney-rivlin or ogden); throws
+/// vb::Error naming the material for missing or impossible parameters.
+HyperelasticLaw law_of(const MaterialSpec& material);
 
 /// Strain energy density W(F) (J/m³).
 double strain_energy(const HyperelasticLaw& law, const Eigen::Matrix3d& F);

@@ -52,12 +52,17 @@ struct ModelSpec {
   bool from_image() const { return !image_path.empty(); }
 };
 
-/// Per-tissue material. Issue 4 adds hyperelastic laws; the core knows linear springs.
+/// Per-tissue material: linear lattice springs, or a hyperelastic law (docs/PHYSICS.md).
 struct MaterialSpec {
   std::string name;
-  std::string law = "linear";
+  std::string law = "linear";  ///< linear | neo-hookean | mooney-rivlin | ogden
   double youngs_modulus_pa = 0;
   double density_kg_m3 = 1000;
+  double poisson_ratio = 0.45;         ///< hyperelastic laws: sets κ unless bulk_modulus_pa is given
+  double bulk_modulus_pa = 0;          ///< κ (Pa); 0: from the shear modulus and poisson_ratio
+  double c10_pa = 0, c01_pa = 0;       ///< Mooney-Rivlin constants (Pa)
+  std::vector<double> ogden_mu_pa;     ///< Ogden μ_p (Pa)
+  std::vector<double> ogden_alpha;     ///< Ogden α_p
   bool rigid = false;  ///< held in place (bone): no motion, anchors its soft neighbours
   int line = 0;
 };
@@ -73,6 +78,7 @@ struct SolverSpec {
   double damping_per_s = 0;         ///< global mass-proportional viscous damping γ (1/s): f = -mγv
   double dashpot_ratio = 0.1;       ///< connection dashpot damping ratio ζ: c = 2ζ√(k·m_reduced)
   int check_every = 100;            ///< steps between equilibrium/instability checks
+  double hourglass = 0.1;           ///< hourglass-control spring fraction for hyperelastic tissues
 };
 
 struct GravitySpec {

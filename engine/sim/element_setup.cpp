@@ -4,6 +4,7 @@
 
 #include "engine/error.hpp"
 #include "engine/loads/anchors.hpp"
+#include "engine/material/hyperelastic.hpp"
 
 namespace vb {
 
@@ -12,8 +13,9 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
   require(n > 0, "the model has no elements", "model", "check the shapes, labels and downsample factor");
   const double volume = std::pow(lattice.spacing_m, 3);
 
-  std::vector<double> E_of_tissue, mass_of_tissue;
+  std::vector<double> E_of_tissue, stability_of_tissue, mass_of_tissue;
   std::vector<bool> rigid_tissue;  // held in place (bone)
+  ElementArrays a;
   for (const std::string& tissue : lattice.tissue_names) {
     auto it = scene.materials.find(tissue);
     require(it != scene.materials.end(), "tissue '" + tissue + "' has no material", "materials." + tissue);
@@ -21,13 +23,31 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
     const std::string where = "materials." + tissue + (m.line ? " (line " + std::to_string(m.line) + ")" : "");
     require(m.youngs_modulus_pa > 0 && std::isfinite(m.youngs_modulus_pa), "Young's modulus must be positive", where);
     require(m.density_kg_m3 > 0 && std::isfinite(m.density_kg_m3), "density must be positive", where);
-    E_of_tissue.push_back(m.youngs_modulus_pa);
     mass_of_tissue.push_back(m.density_kg_m3 * volume);
     rigid_tissue.push_back(m.rigid);
+    std::array<double, 12> row{};  // law 0: linear springs
+    if (m.law == "linear" || m.rigid) {
+      E_of_tissue.push_back(m.youngs_modulus_pa);
+      stability_of_tissue.push_back(m.youngs_modulus_pa);
+    } else {
+      const HyperelasticLaw law = law_of(m);
+      const double mu0 = law.shear_modulus_pa();
+      E_of_tissue.push_back(2.5 * mu0);
+      stability_of_tissue.push_back(law.p_wave_modulus_pa() / 1.2 + 2 * scene.solver.hourglass * 2.5 * mu0);
+      row[0] = law.kind == HyperelasticLaw::Kind::Ogden ? 2 : 1;
+      row[1] = law.terms;
+      for (int p = 0; p < law.terms; ++p) {
+        row[2 + p] = law.mu_pa[p];
+        row[5 + p] = law.alpha[p];
+      }
+      row[8] = law.bulk_modulus_pa;
+      a.hyperelastic = true;
+    }
+    a.material_table.push_back(row);
   }
 
-  ElementArrays a;
   a.youngs_modulus_pa.resize(n);
+  a.stability_modulus_pa.resize(n);
   a.mass_kg.resize(n);
   a.inverse_mass.resize(n);
   a.displacement_m.assign(3 * n, 0.0);
@@ -35,6 +55,7 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
   for (std::size_t e = 0; e < n; ++e) {
     const int t = lattice.tissue_of_element[e];
     a.youngs_modulus_pa[e] = E_of_tissue[t];
+    a.stability_modulus_pa[e] = stability_of_tissue[t];
     a.mass_kg[e] = mass_of_tissue[t];
     a.inverse_mass[e] = anchors.held[e] || rigid_tissue[t] ? 0.0 : 1.0 / mass_of_tissue[t];
     for (int c = 0; c < 3; ++c) a.displacement_m[3 * e + c] = anchors.displacement_m[e][c];

@@ -12,6 +12,12 @@ namespace {
 
 constexpr int kCheckWorkGroup = 128;
 constexpr int kCheckSlots = 9;  // must match VB_CHECK_SLOTS in kernels/checks.cl
+// Kernel argument layout (kernels/common.cl): VB_LATTICE_PARAMS then VB_INDENTER_PARAMS.
+constexpr int kLatticeArgs = 15, kIndenterArgs = 5;
+constexpr int kStepLattice = 4;                              // step kernels: 4 state buffers first
+constexpr int kStepIndenter = kStepLattice + kLatticeArgs;   // then dt, n
+constexpr int kCheckLattice = 2;                             // check_state: u, v first
+constexpr int kCheckIndenter = kCheckLattice + kLatticeArgs; // then partial, partial_arg, n
 
 template <typename T>
 std::vector<T> pack4(const std::vector<double>& xyz, const std::vector<double>* w) {
@@ -69,7 +75,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
           "downsample or crop the model");
 
   const std::size_t state_bytes = 4 * real_size_ * n_;
-  device_bytes_ = estimated_device_bytes(n_, cells, precision_);
+  device_bytes_ = estimated_device_bytes(n_, cells, precision_, el.hyperelastic);
   require(double(device_bytes_) < 0.9 * double(cl.info.global_memory_bytes) &&
               std::max(state_bytes, cells * sizeof(cl_int)) <= cl.info.max_allocation_bytes,
           "the model needs " + mib(double(device_bytes_)) + " of device memory but '" + cl.info.name +
@@ -99,6 +105,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   u_ = make_state_buffer(to_lattice_frame(el.displacement_m), &el.inverse_mass);
   v_ = make_state_buffer(std::vector<double>(3 * n_, 0.0), nullptr);
   u_tmp_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
+  make_hyperelastic_buffers(el);
   v_tmp_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
 
   const std::size_t wg = kCheckWorkGroup;
@@ -117,9 +124,23 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_GLOBAL_DAMPING=" + std::to_string(scene.solver.damping_per_s > 0);
   options += " -DVB_INDENTER=" + std::to_string(!scene.indenters.empty());
   options += " -DVB_RSQRT=" + std::to_string(cl.info.is_gpu);
+  options += " -DVB_HYPER=" + std::to_string(el.hyperelastic);
   options += " -DVB_CHECK_WG=" + std::to_string(kCheckWorkGroup);
-  program_ = build_program(cl, {"common.cl", "lattice_forces.cl", "integrate.cl", "checks.cl"},
+  program_ = build_program(cl, {"common.cl", "hyperelastic.cl", "lattice_forces.cl", "integrate.cl", "checks.cl"},
                            lattice_tables_source(), options);
+  if (hyper_) {
+    stress_ = cl::Kernel(program_, "element_stress");
+    stress_.setArg(1, tissue_);
+    stress_.setArg(2, materials_);
+    stress_.setArg(3, cell_);
+    stress_.setArg(4, grid_);
+    stress_.setArg(5, cl_int(stride_y_));
+    stress_.setArg(6, cl_int(stride_z_));
+    set_real(stress_, 7, lattice_.spacing_m);
+    stress_.setArg(8, Q_);
+    stress_.setArg(9, F_);
+    stress_.setArg(10, cl_uint(n_));
+  }
 
   const bool heun = scene.solver.integrator == Integrator::Heun;
   if (heun) {
@@ -131,18 +152,41 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   check_ = cl::Kernel(program_, "check_state");
   for (cl::Kernel* k : {&euler_, &predict_, &correct_}) {
     if (!(*k)()) continue;
-    set_lattice_args(*k, 4);
-    set_real(*k, 19, dt_.dt_s);
-    k->setArg(20, cl_uint(n_));
+    set_lattice_args(*k, kStepLattice);
+    set_indenter_args(*k, kStepIndenter, 0.0, 0.0);
+    set_real(*k, kStepIndenter + kIndenterArgs, dt_.dt_s);
+    k->setArg(kStepIndenter + kIndenterArgs + 1, cl_uint(n_));
   }
   if (heun) {
     predict_.setArg(0, u_); predict_.setArg(1, v_); predict_.setArg(2, u_tmp_); predict_.setArg(3, v_tmp_);
     correct_.setArg(0, u_); correct_.setArg(1, v_); correct_.setArg(2, u_tmp_); correct_.setArg(3, v_tmp_);
   }
-  set_lattice_args(check_, 2);
-  check_.setArg(17, partial_);
-  check_.setArg(18, partial_arg_);
-  check_.setArg(19, cl_uint(n_));
+  set_lattice_args(check_, kCheckLattice);
+  set_indenter_args(check_, kCheckIndenter, 0.0, 0.0);
+  check_.setArg(kCheckIndenter + kIndenterArgs, partial_);
+  check_.setArg(kCheckIndenter + kIndenterArgs + 1, partial_arg_);
+  check_.setArg(kCheckIndenter + kIndenterArgs + 2, cl_uint(n_));
+}
+
+void Simulator::make_hyperelastic_buffers(const ElementArrays& el) {
+  // Only scenes with hyperelastic tissues get real buffers; others get 1-element placeholders.
+  hyper_ = el.hyperelastic;
+  const auto flags_ro = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
+  std::vector<cl_uchar> tissue(hyper_ ? n_ : 1, 0);
+  if (hyper_) std::copy(lattice_.tissue_of_element.begin(), lattice_.tissue_of_element.end(), tissue.begin());
+  tissue_ = cl::Buffer(cl_.context, flags_ro, tissue.size(), tissue.data());
+  std::vector<double> table;
+  for (const auto& row : el.material_table) table.insert(table.end(), row.begin(), row.end());
+  if (!hyper_) table.assign(12, 0.0);
+  if (precision_ == Precision::Double) {
+    materials_ = cl::Buffer(cl_.context, flags_ro, table.size() * sizeof(double), table.data());
+  } else {
+    std::vector<float> t(table.begin(), table.end());
+    materials_ = cl::Buffer(cl_.context, flags_ro, t.size() * sizeof(float), t.data());
+  }
+  const std::size_t matrix_bytes = (hyper_ ? 3 * n_ : 1) * 4 * real_size_;  // 3 rows of real4
+  Q_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, matrix_bytes);
+  F_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, matrix_bytes);
 }
 
 cl::Buffer Simulator::make_state_buffer(const std::vector<double>& xyz, const std::vector<double>* w) const {
@@ -185,7 +229,11 @@ void Simulator::set_lattice_args(cl::Kernel& k, int a) {
   set_world_vector(k, a + 7, scene_.gravity.active ? scene_.gravity.acceleration_m_s2 : Vec3::Zero());
   set_real(k, a + 8, scene_.solver.damping_per_s);
   set_world_vector(k, a + 9, lattice_.origin_m);
-  set_indenter_args(k, a + 10, 0.0, 0.0);
+  k.setArg(a + 10, tissue_);
+  k.setArg(a + 11, materials_);
+  k.setArg(a + 12, Q_);
+  k.setArg(a + 13, F_);
+  set_real(k, a + 14, scene_.solver.hourglass);
 }
 
 Vec3 Simulator::indenter_position(double t) const {
@@ -210,6 +258,12 @@ void Simulator::set_indenter_args(cl::Kernel& k, int a, double t_force, double t
 
 void Simulator::enqueue(cl::Kernel& k) const { cl_.queue.enqueueNDRangeKernel(k, cl::NullRange, global_, local_); }
 
+void Simulator::enqueue_stress(const cl::Buffer& u) {
+  if (!hyper_) return;
+  stress_.setArg(0, u);
+  enqueue(stress_);
+}
+
 void Simulator::enqueue_check() const {
   // check_state declares reqd_work_group_size, so its local size is always given
   cl_.queue.enqueueNDRangeKernel(check_, cl::NullRange, global_, cl::NDRange(kCheckWorkGroup));
@@ -222,14 +276,17 @@ void Simulator::advance(std::int64_t steps) {
     const double t0 = double(steps_) * dt, t1 = double(steps_ + 1) * dt;
     if (scene_.solver.integrator == Integrator::Heun) {
       if (indenter) {
-        set_indenter_args(predict_, 14, t0, t1);
-        set_indenter_args(correct_, 14, t1, t1);
+        set_indenter_args(predict_, kStepIndenter, t0, t1);
+        set_indenter_args(correct_, kStepIndenter, t1, t1);
       }
+      enqueue_stress(u_);
       enqueue(predict_);
+      enqueue_stress(u_tmp_);
       enqueue(correct_);
     } else {
       euler_.setArg(0, u_); euler_.setArg(1, v_); euler_.setArg(2, u_tmp_); euler_.setArg(3, v_tmp_);
-      if (indenter) set_indenter_args(euler_, 14, t0, t1);
+      if (indenter) set_indenter_args(euler_, kStepIndenter, t0, t1);
+      enqueue_stress(u_);
       enqueue(euler_);
       std::swap(u_, u_tmp_);
       std::swap(v_, v_tmp_);
@@ -241,7 +298,8 @@ void Simulator::advance(std::int64_t steps) {
 StateCheck Simulator::check() {
   check_.setArg(0, u_);
   check_.setArg(1, v_);
-  set_indenter_args(check_, 12, time_s(), time_s());
+  set_indenter_args(check_, kCheckIndenter, time_s(), time_s());
+  enqueue_stress(u_);
   enqueue_check();
   std::vector<double> p(check_groups_ * kCheckSlots);
   if (precision_ == Precision::Double) {
@@ -319,15 +377,15 @@ void Simulator::upload(const std::vector<double>& u, const std::vector<double>& 
   }
 }
 
-std::vector<double> Simulator::lattice_forces() const {
+std::vector<double> Simulator::lattice_forces() {
   cl::Kernel k(program_, "lattice_forces");
   cl::Buffer f(cl_.context, CL_MEM_WRITE_ONLY, 4 * real_size_ * n_);
-  k.setArg(0, u_); k.setArg(1, v_); k.setArg(2, E_); k.setArg(3, cell_); k.setArg(4, grid_);
-  k.setArg(5, cl_int(stride_y_)); k.setArg(6, cl_int(stride_z_));
-  set_real(k, 7, lattice_.spacing_m);
-  set_real(k, 8, scene_.solver.dashpot_ratio);
-  k.setArg(9, f);
-  k.setArg(10, cl_uint(n_));
+  k.setArg(0, u_);
+  k.setArg(1, v_);
+  set_lattice_args(k, 2);
+  k.setArg(2 + kLatticeArgs, f);
+  k.setArg(3 + kLatticeArgs, cl_uint(n_));
+  enqueue_stress(u_);
   enqueue(k);
   std::vector<double> out;
   if (precision_ == Precision::Double) read_xyz<double>(f, out); else read_xyz<float>(f, out);

@@ -40,7 +40,7 @@ class Simulator {
   void download(std::vector<double>& u_m, std::vector<double>& v_m_s) const;
   void upload(const std::vector<double>& u_m, const std::vector<double>& v_m_s);
   /// Lattice spring + dashpot forces at the current state (n×3, N, world frame); for tests.
-  std::vector<double> lattice_forces() const;
+  std::vector<double> lattice_forces();
 
   double dt_s() const { return dt_.dt_s; }
   const TimeStepChoice& time_step() const { return dt_; }
@@ -65,6 +65,8 @@ class Simulator {
   std::vector<double> to_lattice_frame(const std::vector<double>& world) const;
   void enqueue(cl::Kernel& k) const;
   void enqueue_check() const;
+  void enqueue_stress(const cl::Buffer& u);
+  void make_hyperelastic_buffers(const ElementArrays& el);
   cl::Buffer make_state_buffer(const std::vector<double>& xyz, const std::vector<double>* w) const;
 
   const Scene& scene_;
@@ -82,6 +84,9 @@ class Simulator {
   std::size_t check_groups_ = 0;
 
   cl::Buffer u_, v_, u_tmp_, v_tmp_, E_, cell_, grid_, partial_, partial_arg_;
+  bool hyper_ = false;
+  cl::Buffer tissue_, materials_, Q_, F_;  ///< hyperelastic: tissue ids, law table, Q and F rows
+  cl::Kernel stress_;
   cl::Program program_;
   cl::Kernel euler_, predict_, correct_;
   mutable cl::Kernel check_;

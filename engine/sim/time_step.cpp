@@ -16,7 +16,8 @@ StabilityBounds stability_bounds(const Lattice& lattice, const ElementArrays& el
   double omega_sq = 0, c_max = 0;
   for (std::size_t e = 0; e < lattice.element_count(); ++e) {
     if (el.inverse_mass[e] == 0) continue;
-    const auto k = connection_stiffness(lattice, el.youngs_modulus_pa, e);
+    const auto k = connection_stiffness(lattice, el.stability_modulus_pa, e);
+    const auto k_dashpot = connection_stiffness(lattice, el.youngs_modulus_pa, e);  // what the dashpots use
     const auto nb = lattice.neighbours(e);
     for (int a = 0; a < 3; ++a) {
       double k_row = 0, c_row = 0;
@@ -26,7 +27,7 @@ StabilityBounds stability_bounds(const Lattice& lattice, const ElementArrays& el
         const double w = std::abs(n[a]) * n.cwiseAbs().sum();  // Σ_b |n_a n_b|
         const double reduced_mass = 1.0 / (el.inverse_mass[e] + el.inverse_mass[nb[d]]);
         k_row += 2 * k[d] * w;
-        c_row += 2 * (2 * dashpot_ratio * std::sqrt(k[d] * reduced_mass)) * w;
+        c_row += 2 * (2 * dashpot_ratio * std::sqrt(k_dashpot[d] * reduced_mass)) * w;
       }
       omega_sq = std::max(omega_sq, k_row * el.inverse_mass[e]);
       c_max = std::max(c_max, c_row * el.inverse_mass[e]);

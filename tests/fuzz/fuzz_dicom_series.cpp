@@ -45,7 +45,8 @@ constexpr int kMaxFiles = 4;
 /// One private folder per process under $TMPDIR (or /tmp), removed at exit; it is the series
 /// folder itself.
 const fs::path& work_dir() {
-  static const fs::path dir = [] {
+  // Never destroyed, so that the atexit handler below can still use it at exit.
+  static const fs::path& dir = *new fs::path([] {
     const char* base = std::getenv("TMPDIR");
     std::string pattern = std::string(base && *base ? base : "/tmp") + "/vb-fuzz-dicom-XXXXXX";
     if (!::mkdtemp(pattern.data())) {
@@ -56,8 +57,8 @@ const fs::path& work_dir() {
       std::error_code ignored;
       fs::remove_all(work_dir(), ignored);
     });
-    return fs::path(pattern);
-  }();
+    return pattern;
+  }());
   return dir;
 }
 

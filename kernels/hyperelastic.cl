@@ -1,0 +1,229 @@
+// Hyperelastic elements (compiled when VB_HYPER is 1). Pass 1, element_stress, computes each
+// element's deformation gradient by least squares over its existing neighbours,
+//   F = A·B⁻¹,  A = Σ Δx ΔXᵀ,  B = Σ ΔX ΔXᵀ  (ΔX = h·d rest offsets, Δx deformed),
+// the law's first Piola-Kirchhoff stress P(F), and Q = V·P·B⁻¹. The energy V·W(F_e) then puts
+// force Q_e·(h·d) on each neighbour and −Q_e·Σ h·d on the element itself (pass 2 gathers them in
+// lattice_force): total force and torque vanish and rigid motions give none.
+//
+// Material table (global const real*, VB_MAT_STRIDE reals per tissue):
+//   0 law (0 linear springs, 1 neo-Hookean/Mooney-Rivlin by invariants, 2 Ogden by stretches)
+//   1 terms N, 2..4 μ_p (Pa), 5..7 α_p, 8 κ (Pa)
+#if VB_HYPER
+#define VB_MAT_STRIDE 12
+
+typedef struct {
+  real m[3][3];
+} mat3;
+
+inline mat3 mat3_zero(void) {
+  mat3 r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.m[i][j] = 0;
+  return r;
+}
+
+inline mat3 mat3_identity(void) {
+  mat3 r = mat3_zero();
+  r.m[0][0] = r.m[1][1] = r.m[2][2] = 1;
+  return r;
+}
+
+inline mat3 mat3_mul(mat3 a, mat3 b) {
+  mat3 r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[i][0] * b.m[0][j] + a.m[i][1] * b.m[1][j] + a.m[i][2] * b.m[2][j];
+  return r;
+}
+
+inline mat3 mat3_transpose_mul(mat3 a, mat3 b) {  // aᵀ·b
+  mat3 r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[0][i] * b.m[0][j] + a.m[1][i] * b.m[1][j] + a.m[2][i] * b.m[2][j];
+  return r;
+}
+
+inline real mat3_det(mat3 a) {
+  return a.m[0][0] * (a.m[1][1] * a.m[2][2] - a.m[1][2] * a.m[2][1]) -
+         a.m[0][1] * (a.m[1][0] * a.m[2][2] - a.m[1][2] * a.m[2][0]) +
+         a.m[0][2] * (a.m[1][0] * a.m[2][1] - a.m[1][1] * a.m[2][0]);
+}
+
+inline mat3 mat3_inverse(mat3 a, real det) {
+  mat3 r;
+  const real s = 1 / det;
+  r.m[0][0] = (a.m[1][1] * a.m[2][2] - a.m[1][2] * a.m[2][1]) * s;
+  r.m[0][1] = (a.m[0][2] * a.m[2][1] - a.m[0][1] * a.m[2][2]) * s;
+  r.m[0][2] = (a.m[0][1] * a.m[1][2] - a.m[0][2] * a.m[1][1]) * s;
+  r.m[1][0] = (a.m[1][2] * a.m[2][0] - a.m[1][0] * a.m[2][2]) * s;
+  r.m[1][1] = (a.m[0][0] * a.m[2][2] - a.m[0][2] * a.m[2][0]) * s;
+  r.m[1][2] = (a.m[0][2] * a.m[1][0] - a.m[0][0] * a.m[1][2]) * s;
+  r.m[2][0] = (a.m[1][0] * a.m[2][1] - a.m[1][1] * a.m[2][0]) * s;
+  r.m[2][1] = (a.m[0][1] * a.m[2][0] - a.m[0][0] * a.m[2][1]) * s;
+  r.m[2][2] = (a.m[0][0] * a.m[1][1] - a.m[0][1] * a.m[1][0]) * s;
+  return r;
+}
+
+inline real4 mat3_apply(mat3 a, real4 v) {
+  return (real4)(a.m[0][0] * v.x + a.m[0][1] * v.y + a.m[0][2] * v.z,
+                 a.m[1][0] * v.x + a.m[1][1] * v.y + a.m[1][2] * v.z,
+                 a.m[2][0] * v.x + a.m[2][1] * v.y + a.m[2][2] * v.z, 0);
+}
+
+inline void mat3_store(global real4* rows, uint e, mat3 a) {
+  for (int i = 0; i < 3; ++i) rows[3 * e + i] = (real4)(a.m[i][0], a.m[i][1], a.m[i][2], 0);
+}
+
+inline mat3 mat3_load(global const real4* rows, uint e) {
+  mat3 a;
+  for (int i = 0; i < 3; ++i) {
+    const real4 r = rows[3 * e + i];
+    a.m[i][0] = r.x;
+    a.m[i][1] = r.y;
+    a.m[i][2] = r.z;
+  }
+  return a;
+}
+
+// J clamped for the isochoric terms: an inverted or crushed element (J ≤ 0) keeps finite
+// stresses while the volumetric term κJ(J − 1) pushes it back open.
+#define VB_J_FLOOR ((real)0.05)
+
+// Second Piola-Kirchhoff stress of Mooney-Rivlin (neo-Hookean when C01 = 0) from invariants:
+//   S = 2C10 J^(−2/3)(I − I1/3 C⁻¹) + 2C01 J^(−4/3)(I1 I − C − 2/3 I2 C⁻¹) + κJ(J − 1) C⁻¹
+inline mat3 stress_invariants(mat3 C, real J, real c10, real c01, real kappa) {
+  const real detC = mat3_det(C);
+  const mat3 Ci = mat3_inverse(C, detC);
+  const real I1 = C.m[0][0] + C.m[1][1] + C.m[2][2];
+  real I2 = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) I2 -= C.m[i][j] * C.m[j][i];
+  I2 = (real)0.5 * (I1 * I1 + I2);
+  const real Jc = fmax(J, VB_J_FLOOR);
+  const real a = 2 * c10 * pow(Jc, (real)(-2.0 / 3.0)), b = 2 * c01 * pow(Jc, (real)(-4.0 / 3.0));
+  const real vol = kappa * J * (J - 1);
+  mat3 S;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const real id = i == j ? 1 : 0;
+      S.m[i][j] = a * (id - I1 / 3 * Ci.m[i][j]) + b * (I1 * id - C.m[i][j] - (real)(2.0 / 3.0) * I2 * Ci.m[i][j]) +
+                  vol * Ci.m[i][j];
+    }
+  return S;
+}
+
+// Cyclic Jacobi eigen-decomposition of symmetric C: C = V·diag(w)·Vᵀ (robust when eigenvalues
+// coincide, as at rest).
+inline void eigen_symmetric(mat3 C, real w[3], mat3* V) {
+  mat3 A = C;
+  *V = mat3_identity();
+  for (int sweep = 0; sweep < 8; ++sweep) {
+    for (int p = 0; p < 2; ++p)
+      for (int q = p + 1; q < 3; ++q) {
+        const real apq = A.m[p][q];
+        if (fabs(apq) < (real)1e-30) continue;
+        const real theta = (A.m[q][q] - A.m[p][p]) / (2 * apq);
+        const real t = sign(theta) / (fabs(theta) + sqrt(theta * theta + 1)) + (theta == 0 ? 1 : 0);
+        const real c = 1 / sqrt(t * t + 1), s = t * c;
+        for (int k = 0; k < 3; ++k) {  // A ← Jᵀ A J
+          const real akp = A.m[k][p], akq = A.m[k][q];
+          A.m[k][p] = c * akp - s * akq;
+          A.m[k][q] = s * akp + c * akq;
+        }
+        for (int k = 0; k < 3; ++k) {
+          const real apk = A.m[p][k], aqk = A.m[q][k];
+          A.m[p][k] = c * apk - s * aqk;
+          A.m[q][k] = s * apk + c * aqk;
+        }
+        for (int k = 0; k < 3; ++k) {
+          const real vkp = V->m[k][p], vkq = V->m[k][q];
+          V->m[k][p] = c * vkp - s * vkq;
+          V->m[k][q] = s * vkp + c * vkq;
+        }
+      }
+  }
+  for (int i = 0; i < 3; ++i) w[i] = A.m[i][i];
+}
+
+// Ogden from principal stretches: τ_i = Σ_p μ_p(λ̄_i^α_p − ⅓Σ_k λ̄_k^α_p) + κJ(J − 1);
+// S = Σ τ_i/λ_i² N_i N_iᵀ.
+inline mat3 stress_ogden(mat3 C, real J, global const real* mat) {
+  real w[3];
+  mat3 N;
+  eigen_symmetric(C, w, &N);
+  const real Jc = fmax(J, VB_J_FLOOR);
+  const real scale = pow(Jc, (real)(-1.0 / 3.0));
+  real tau[3];
+  real lbar[3];
+  for (int i = 0; i < 3; ++i) {
+    w[i] = fmax(w[i], (real)1e-12);
+    lbar[i] = sqrt(w[i]) * scale;
+    tau[i] = mat[8] * J * (J - 1);
+  }
+  const int terms = (int)mat[1];
+  for (int p = 0; p < terms; ++p) {
+    const real mu = mat[2 + p], alpha = mat[5 + p];
+    real la[3], sum = 0;
+    for (int i = 0; i < 3; ++i) {
+      la[i] = pow(lbar[i], alpha);
+      sum += la[i];
+    }
+    for (int i = 0; i < 3; ++i) tau[i] += mu * (la[i] - sum / 3);
+  }
+  mat3 S = mat3_zero();
+  for (int i = 0; i < 3; ++i) {
+    const real f = tau[i] / w[i];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) S.m[a][b] += f * N.m[a][i] * N.m[b][i];
+  }
+  return S;
+}
+
+// Pass 1: per-element F and Q (rows of 3×3 matrices stored as 3 real4 each).
+kernel void element_stress(global const real4* u, global const uchar* tissue_of, global const real* materials,
+                           global const uint* cell_of, global const int* grid, int sy, int sz, real h,
+                           global real4* Q_out, global real4* F_out, uint n) {
+  const uint e = get_global_id(0);
+  if (e >= n) return;
+  global const real* mat = materials + VB_MAT_STRIDE * tissue_of[e];
+  const int law = (int)mat[0];
+  if (law == 0) {  // linear-spring tissue: no element stress
+    mat3_store(Q_out, e, mat3_zero());
+    mat3_store(F_out, e, mat3_identity());
+    return;
+  }
+  const int cell = (int)cell_of[e];
+  const real4 ue = u[e];
+  mat3 A = mat3_zero(), B = mat3_zero();  // B in units of h²
+  for (int d = 0; d < 26; ++d) {
+    const int j = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
+    if (j < 0) continue;
+    const real4 uj = u[j];
+    const real dX[3] = {VB_DIR[d][0], VB_DIR[d][1], VB_DIR[d][2]};
+    const real dx[3] = {h * dX[0] + (uj.x - ue.x), h * dX[1] + (uj.y - ue.y), h * dX[2] + (uj.z - ue.z)};
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        A.m[a][b] += dx[a] * dX[b];  // in units of h (dX dimensionless)
+        B.m[a][b] += dX[a] * dX[b];
+      }
+  }
+  const real detB = mat3_det(B);
+  if (detB < (real)0.5) {  // neighbours do not span 3-D (a thin strand): no element stress
+    mat3_store(Q_out, e, mat3_zero());
+    mat3_store(F_out, e, mat3_identity());
+    return;
+  }
+  const mat3 Bi = mat3_inverse(B, detB);
+  mat3 F = mat3_mul(A, Bi);
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) F.m[a][b] /= h;
+  const real J = mat3_det(F);
+  const mat3 C = mat3_transpose_mul(F, F);
+  const mat3 S = law == 1 ? stress_invariants(C, J, (real)0.5 * mat[2], (real)-0.5 * mat[3], mat[8])
+                          : stress_ogden(C, J, mat);
+  mat3 Q = mat3_mul(mat3_mul(F, S), Bi);  // V·P·B⁻¹ with V = h³ and B = h²·B' → h·P·B'⁻¹
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) Q.m[a][b] *= h;
+  mat3_store(Q_out, e, Q);
+  mat3_store(F_out, e, F);
+}
+#endif  // VB_HYPER
