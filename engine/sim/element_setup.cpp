@@ -21,7 +21,8 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
     require(it != scene.materials.end(), "tissue '" + tissue + "' has no material", "materials." + tissue);
     const MaterialSpec& m = it->second;
     const std::string where = "materials." + tissue + (m.line ? " (line " + std::to_string(m.line) + ")" : "");
-    require(m.youngs_modulus_pa > 0 && std::isfinite(m.youngs_modulus_pa), "Young's modulus must be positive", where);
+    if (m.law == "linear")  // hyperelastic laws check their own parameters (law_of)
+      require(m.youngs_modulus_pa > 0 && std::isfinite(m.youngs_modulus_pa), "Young's modulus must be positive", where);
     require(m.density_kg_m3 > 0 && std::isfinite(m.density_kg_m3), "density must be positive", where);
     mass_of_tissue.push_back(m.density_kg_m3 * volume);
     rigid_tissue.push_back(m.rigid);

@@ -2,9 +2,28 @@
 
 #include <cmath>
 
+#include <Eigen/Dense>
+
+#include "engine/material/hyperelastic.hpp"
 #include "engine/material/linear_spring.hpp"
 
 namespace vb {
+
+namespace {
+
+/// The law of a kernel material-table row (law 0 → none: linear springs).
+std::optional<HyperelasticLaw> law_of_row(const std::array<double, 12>& row) {
+  if (row[0] == 0) return std::nullopt;
+  std::vector<double> mu, alpha;
+  for (int p = 0; p < int(row[1]); ++p) {
+    mu.push_back(row[2 + p]);
+    alpha.push_back(row[5 + p]);
+  }
+  return ogden(mu, alpha, row[8]);
+}
+
+}  // namespace
+
 
 std::array<double, 26> connection_stiffness(const Lattice& lattice, const std::vector<double>& E,
                                             std::size_t e) {
@@ -22,11 +41,39 @@ HostReference::HostReference(const Lattice& lattice, const ElementArrays& elemen
       el_(elements),
       gravity_(lattice.rotation.transpose() * (scene.gravity.active ? scene.gravity.acceleration_m_s2 : Vec3::Zero())),
       damping_(scene.solver.damping_per_s),
+      hourglass_(scene.solver.hourglass),
       dashpot_ratio_(scene.solver.dashpot_ratio),
       integrator_(scene.solver.integrator) {
+  for (const auto& row : elements.material_table) laws_.push_back(law_of_row(row));
   for (std::size_t e = 0; e < lattice.element_count(); ++e) {
     neighbours_.push_back(lattice.neighbours(e));
     stiffness_.push_back(connection_stiffness(lattice, elements.youngs_modulus_pa, e));
+  }
+}
+
+void HostReference::element_stresses(const std::vector<double>& u, std::vector<Eigen::Matrix3d>& F,
+                                     std::vector<Eigen::Matrix3d>& Q) const {
+  const std::size_t n = lattice_.element_count();
+  const double h = lattice_.spacing_m;
+  const auto& offsets = neighbour_offsets();
+  F.assign(n, Eigen::Matrix3d::Identity());
+  Q.assign(n, Eigen::Matrix3d::Zero());
+  for (std::size_t e = 0; e < n; ++e) {
+    const auto& law = laws_[lattice_.tissue_of_element[e]];
+    if (!law) continue;
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero(), B = Eigen::Matrix3d::Zero();
+    for (int d = 0; d < 26; ++d) {
+      if (neighbours_[e][d] < 0) continue;
+      const std::size_t j = std::size_t(neighbours_[e][d]);
+      const Vec3 dX(offsets[d][0], offsets[d][1], offsets[d][2]);
+      const Vec3 dx = h * dX + Vec3(u[3 * j] - u[3 * e], u[3 * j + 1] - u[3 * e + 1], u[3 * j + 2] - u[3 * e + 2]);
+      A += dx * dX.transpose();
+      B += dX * dX.transpose();
+    }
+    if (B.determinant() < 0.5) continue;  // as the kernel: neighbours do not span 3-D
+    const Eigen::Matrix3d Bi = B.inverse();
+    F[e] = A * Bi / h;
+    Q[e] = h * first_piola(*law, F[e]) * Bi;
   }
 }
 
@@ -35,24 +82,33 @@ std::vector<double> HostReference::lattice_forces(const std::vector<double>& u,
   const std::size_t n = lattice_.element_count();
   const auto& offsets = neighbour_offsets();
   const double h = lattice_.spacing_m;
+  std::vector<Eigen::Matrix3d> F, Q;
+  if (el_.hyperelastic) element_stresses(u, F, Q);
+  const auto hyper = [&](std::size_t e) { return el_.hyperelastic && laws_[lattice_.tissue_of_element[e]].has_value(); };
   std::vector<double> f(3 * n, 0.0);
   for (std::size_t e = 0; e < n; ++e) {
     const Vec3 ue(u[3 * e], u[3 * e + 1], u[3 * e + 2]), ve(v[3 * e], v[3 * e + 1], v[3 * e + 2]);
-    Vec3 fe = Vec3::Zero();
+    Vec3 fe = Vec3::Zero(), own_offsets = Vec3::Zero();
     for (int d = 0; d < 26; ++d) {
       const double k = stiffness_[e][d];
       if (k == 0) continue;
       const std::size_t j = neighbours_[e][d];
+      const Vec3 hd = h * Vec3(offsets[d][0], offsets[d][1], offsets[d][2]);
       const Vec3 uj(u[3 * j], u[3 * j + 1], u[3 * j + 2]), vj(v[3 * j], v[3 * j + 1], v[3 * j + 2]);
-      const Vec3 r = h * Vec3(offsets[d][0], offsets[d][1], offsets[d][2]) + (uj - ue);
-      const double len = r.norm();
+      const Vec3 r = hd + (uj - ue);
+      const double len = r.norm(), rest = hd.norm();
       const Vec3 nrm = r / len;
-      double magnitude = k * (len - h * linear_spring::rest_length_factor(d));
+      // Each end adds half a spring; a hyperelastic end's rest length is its affine prediction.
+      double magnitude = hyper(e) ? hourglass_ * k * (len - (F[e] * hd).norm()) : 0.5 * k * (len - rest);
+      magnitude += hyper(j) ? hourglass_ * k * (len - (F[j] * hd).norm()) : 0.5 * k * (len - rest);
+      if (hyper(j)) fe += Q[j] * hd;
+      own_offsets += hd;
       const double inv_mass_sum = el_.inverse_mass[e] + el_.inverse_mass[j];
       if (dashpot_ratio_ > 0 && inv_mass_sum > 0)
         magnitude += 2 * dashpot_ratio_ * std::sqrt(k / inv_mass_sum) * (vj - ve).dot(nrm);
       fe += magnitude * nrm;
     }
+    if (hyper(e)) fe += Q[e] * own_offsets;
     for (int c = 0; c < 3; ++c) f[3 * e + c] = fe[c];
   }
   return f;

@@ -6,7 +6,10 @@
 #include <array>
 #include <vector>
 
+#include <optional>
+
 #include "engine/lattice/lattice.hpp"
+#include "engine/material/hyperelastic.hpp"
 #include "engine/scene/scene.hpp"
 #include "engine/sim/element_setup.hpp"
 
@@ -22,6 +25,9 @@ class HostReference {
 
   /// Lattice spring + dashpot force on every element (n×3, N) at displacement u, velocity v.
   std::vector<double> lattice_forces(const std::vector<double>& u, const std::vector<double>& v) const;
+  /// Per-element deformation gradient F and Q = V·P·B⁻¹ (identity / zero for spring tissues).
+  void element_stresses(const std::vector<double>& u, std::vector<Eigen::Matrix3d>& F,
+                        std::vector<Eigen::Matrix3d>& Q) const;
   /// Advances `steps` steps of the scene's integrator (gravity, damping; no indenter).
   void step(double dt, int steps);
 
@@ -34,7 +40,8 @@ class HostReference {
   std::vector<std::array<std::int32_t, 26>> neighbours_;
   std::vector<std::array<double, 26>> stiffness_;
   Vec3 gravity_;
-  double damping_, dashpot_ratio_;
+  double damping_, hourglass_, dashpot_ratio_;
+  std::vector<std::optional<HyperelasticLaw>> laws_;  ///< per tissue; empty for spring tissues
   Integrator integrator_;
 };
 
