@@ -17,6 +17,7 @@
 
 #include "engine/error.hpp"
 #include "engine/material/default_materials.hpp"
+#include "engine/material/hyperelastic.hpp"
 #include "engine/loads/posture.hpp"
 
 namespace vb {
@@ -228,6 +229,21 @@ class Section {
     if (!node) return std::nullopt;
     if (!node->is_string()) wrong_type(key, *node, "a string");
     return node->as_string()->get();
+  }
+
+  /// An array of 1 to 3 finite numbers (Ogden parameters); absent → nullopt.
+  std::optional<std::vector<double>> numbers(std::string_view key) const {
+    const toml::node* node = find(key);
+    if (!node) return std::nullopt;
+    const toml::array* array = node->as_array();
+    if (!array || array->empty() || array->size() > 3) wrong_type(key, *node, "an array of 1 to 3 numbers");
+    std::vector<double> out;
+    for (const toml::node& n : *array) {
+      const std::optional<double> x = as_double(n);
+      if (!x || !std::isfinite(*x)) fail(key, "expected finite numbers, got " + describe(n));
+      out.push_back(*x);
+    }
+    return out;
   }
 
   std::optional<bool> boolean(std::string_view key) const {
@@ -498,35 +514,61 @@ ModelSpec read_model(const Section& s) {
 }
 
 void check_law(const Section& s, const std::string& law) {
-  const Keys available = {"linear"};
-  const Keys later = {"biphasic_spring", "neo-hookean", "neo_hookean", "mooney-rivlin", "ogden"};
+  const Keys available = {"linear", "neo-hookean", "mooney-rivlin", "ogden"};
+  const Keys later = {"biphasic_spring"};
   if (contains(available, law)) return;
-  if (contains(later, law)) {
-    s.fail("law", "law '" + law + "' is not available in this version", "use law = \"linear\"");
-  }
+  if (contains(later, law)) s.fail("law", "law '" + law + "' is not available in this version", "use " + joined(available));
   s.fail("law", "unknown law '" + law + "'", choice_hint(law, available));
 }
 
+/// Keys each law reads; any other law key in the table is a mix-up and an error.
+const std::map<std::string, Keys> kLawKeys = {
+    {"linear", {"E"}},
+    {"neo-hookean", {"E", "nu", "bulk_modulus"}},
+    {"mooney-rivlin", {"c10", "c01", "nu", "bulk_modulus"}},
+    {"ogden", {"mu", "alpha", "nu", "bulk_modulus"}},
+};
+
 /// A tissue with a default (docs/MATERIALS.md) may give only the values it changes.
 MaterialSpec read_material(const std::string& name, const Section& s) {
-  s.check_keys({"law", "E", "density", "nu", "rigid"});
+  s.check_keys({"law", "E", "density", "nu", "rigid", "bulk_modulus", "c10", "c01", "mu", "alpha"});
   const std::optional<MaterialSpec> fallback = default_material(name);
   MaterialSpec m = fallback.value_or(MaterialSpec{});
   m.name = name;
   m.line = s.line();
-  m.law = s.text("law").value_or(m.law);
-  check_law(s, m.law);
-  if (m.law == "linear" && s.find("nu")) {
-    s.fail(
-        "nu",
-        "linear lattice springs have Poisson ratio 0.25 fixed; 'nu' applies to hyperelastic laws",
-        "remove 'nu'");
+  const std::optional<std::string> law = s.text("law");
+  if (law) {
+    m.law = *law == "neo_hookean" ? "neo-hookean" : *law == "mooney_rivlin" ? "mooney-rivlin" : *law;
+    check_law(s, m.law);
+  }
+  for (const char* key : {"E", "nu", "bulk_modulus", "c10", "c01", "mu", "alpha"}) {
+    if (!s.find(key) || contains(kLawKeys.at(m.law), key)) continue;
+    if (m.law == "linear" && std::string_view(key) == "nu")
+      s.fail(key, "linear lattice springs have Poisson ratio 0.25 fixed; 'nu' applies to hyperelastic laws", "remove 'nu'");
+    s.fail(key, "'" + std::string(key) + "' does not apply to law '" + m.law + "'", "keys for this law: " + joined(kLawKeys.at(m.law)));
   }
   m.rigid = s.boolean("rigid").value_or(m.rigid);
   const std::optional<double> E = s.positive("E");
-  if (!E && !fallback && !m.rigid) s.fail("E", "missing required key", "'" + name + "' has no default material");
-  m.youngs_modulus_pa = E.value_or(fallback ? fallback->youngs_modulus_pa : 1.0);
+  const bool needs_E = m.law == "linear" || m.law == "neo-hookean";
+  if (needs_E && !E && !fallback && !m.rigid) s.fail("E", "missing required key", "'" + name + "' has no default material");
+  m.youngs_modulus_pa = E.value_or(fallback ? fallback->youngs_modulus_pa : m.rigid ? 1e12 : 0.0);
   m.density_kg_m3 = s.positive("density").value_or(m.density_kg_m3);
+  m.poisson_ratio = s.number("nu").value_or(m.poisson_ratio);
+  m.bulk_modulus_pa = s.positive("bulk_modulus").value_or(0.0);
+  m.c10_pa = s.number("c10").value_or(0.0);
+  m.c01_pa = s.number("c01").value_or(0.0);
+  m.ogden_mu_pa = s.numbers("mu").value_or(std::vector<double>{});
+  m.ogden_alpha = s.numbers("alpha").value_or(std::vector<double>{});
+  if (m.law == "mooney-rivlin" && !s.find("c10")) s.fail("c10", "missing required key");
+  if (m.law == "ogden" && !(s.find("mu") && s.find("alpha"))) s.fail(s.find("mu") ? "alpha" : "mu", "missing required key");
+  if (m.law != "linear" && !m.rigid) {
+    try {
+      (void)law_of(m);  // parameters that make no material fail here, at their line
+    } catch (const Error& e) {
+      const std::string key = e.location().substr(e.location().rfind('.') + 1);
+      s.fail(s.find(key) ? key : "law", e.problem(), e.hint());
+    }
+  }
   return m;
 }
 
@@ -556,7 +598,7 @@ std::optional<double> read_dt(const Section& s) {
 
 SolverSpec read_solver(const Section& s) {
   s.check_keys(
-      {"integrator", "dt", "dt_safety", "precision", "damping", "dashpot_ratio", "check_every"});
+      {"integrator", "dt", "dt_safety", "precision", "damping", "dashpot_ratio", "check_every", "hourglass"});
   SolverSpec v;
   if (const auto* n = s.named("integrator", kIntegrators)) v.integrator = n->value;
   v.dt_s = read_dt(s);
@@ -566,6 +608,7 @@ SolverSpec read_solver(const Section& s) {
   v.damping_per_s = s.non_negative("damping").value_or(v.damping_per_s);
   v.dashpot_ratio = s.non_negative("dashpot_ratio").value_or(v.dashpot_ratio);
   v.check_every = s.integer<int>("check_every", 1).value_or(v.check_every);
+  v.hourglass = s.non_negative("hourglass").value_or(v.hourglass);
   return v;
 }
 
