@@ -215,35 +215,34 @@ void write_attribute(const Object& object, const std::string& name,
 
 // ---- the result file -----------------------------------------------------------------------
 
-/// Per-element voxel indices (n×3) and rest positions (n×3, m), from the lattice's public
-/// fields (same rule as Lattice::voxel_ijk / rest_position: x fastest, centres at integers).
+/// Per-element voxel indices (n×3) and rest positions (n×3, m, world frame).
 struct ElementGeometry {
   std::vector<std::int32_t> voxel_ijk;
   std::vector<double> rest_position_m;
 };
 
 ElementGeometry element_geometry(const Lattice& lattice) {
-  const std::size_t nx = static_cast<std::size_t>(lattice.dims[0]);
-  const std::size_t ny = static_cast<std::size_t>(lattice.dims[1]);
   ElementGeometry g;
   g.voxel_ijk.reserve(3 * lattice.element_count());
   g.rest_position_m.reserve(3 * lattice.element_count());
-  for (const std::uint32_t v : lattice.voxel_of_element) {
-    const std::array<std::size_t, 3> ijk{v % nx, (v / nx) % ny, v / (nx * ny)};
+  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+    const auto ijk = lattice.voxel_ijk(e);
+    const Eigen::Vector3d x = lattice.rest_position(e);  // includes the lattice's rotation
     for (int a = 0; a < 3; ++a) {
-      g.voxel_ijk.push_back(static_cast<std::int32_t>(ijk[a]));
-      g.rest_position_m.push_back(lattice.origin_m[a] +
-                                  lattice.spacing_m * static_cast<double>(ijk[a]));
+      g.voxel_ijk.push_back(ijk[a]);
+      g.rest_position_m.push_back(x[a]);
     }
   }
   return g;
 }
 
-/// Voxel index → world (m), 4×4 row-major: scale by the spacing, translate by the origin.
+/// Voxel index → world (m), 4×4 row-major (rotation × spacing, then the origin).
 std::vector<double> affine_rows(const Lattice& lattice) {
-  const double h = lattice.spacing_m;
-  const Eigen::Vector3d& o = lattice.origin_m;
-  return {h, 0, 0, o.x(), 0, h, 0, o.y(), 0, 0, h, o.z(), 0, 0, 0, 1};
+  const Eigen::Matrix4d a = lattice.affine();
+  std::vector<double> rows;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) rows.push_back(a(r, c));
+  return rows;
 }
 
 void write_materials(const Object& model, const std::map<std::string, MaterialSpec>& materials) {

@@ -30,8 +30,13 @@ const char* integrator_name(Integrator i) { return i == Integrator::Heun ? "heun
 }  // namespace
 
 std::pair<double, double> equilibrium_scales(const Lattice& lattice, const ElementArrays& el) {
-  const double E_max = *std::max_element(el.youngs_modulus_pa.begin(), el.youngs_modulus_pa.end());
-  const double m_min = *std::min_element(el.mass_kg.begin(), el.mass_kg.end());
+  // Over the free elements: held tissue (rigid bone at 1 GPa, say) must not loosen the criterion.
+  double E_max = 0, m_min = INFINITY;
+  for (std::size_t e = 0; e < el.mass_kg.size(); ++e) {
+    if (el.inverse_mass[e] == 0) continue;
+    E_max = std::max(E_max, el.youngs_modulus_pa[e]);
+    m_min = std::min(m_min, el.mass_kg[e]);
+  }
   const double h = lattice.spacing_m;
   return {E_max * h * h, std::sqrt(E_max / (m_min / (h * h * h)))};
 }

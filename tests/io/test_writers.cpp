@@ -253,6 +253,17 @@ TEST_F(Writers, Hdf5ModelRoundTrips) {
             (std::vector<double>{950.0}));
 }
 
+TEST_F(Writers, Hdf5ModelOfARotatedLatticeIsInTheWorldFrame) {
+  lattice_.rotation << 0, -1, 0, 1, 0, 0, 0, 0, 1;  // lattice x axis along world y (oblique CT)
+  const ReadFile file(write_h5(tiny_state()));
+  const auto rest = file.read<double>("/model/rest_position_m", H5T_NATIVE_DOUBLE);
+  EXPECT_NEAR(rest[3], 0.1, 1e-15);    // the second element is one voxel along world +y
+  EXPECT_NEAR(rest[4], -0.198, 1e-15);
+  const auto affine = file.read<double>("/model/affine_voxel_to_world_m", H5T_NATIVE_DOUBLE);
+  EXPECT_DOUBLE_EQ(affine[4], 0.002);  // row y, column i
+  EXPECT_DOUBLE_EQ(affine[0], 0.0);
+}
+
 TEST_F(Writers, Hdf5StateAndFramesRoundTrip) {
   const FinalState state = tiny_state();
   const ReadFile file(write_h5(state));
