@@ -1,6 +1,6 @@
 // Precision and feature switches shared by every kernel. The host passes
 //   -DVB_DOUBLE=0|1   real = float | double
-//   -DVB_GRAVITY=0|1, -DVB_DASHPOT=0|1, -DVB_GLOBAL_DAMPING=0|1, -DVB_INDENTER=0|1
+//   -DVB_GRAVITY=0|1, -DVB_DASHPOT=0|1, -DVB_GLOBAL_DAMPING=0|1, -DVB_INDENTERS=count
 //                     so only what the scene uses is compiled
 //   -DVB_RSQRT=0|1    1/|r| by rsqrt (GPUs) or 1/sqrt (CPUs, where rsqrt is a library call)
 //   -DVB_HYPER=0|1    hyperelastic tissues present (kernels/hyperelastic.cl)
@@ -42,7 +42,10 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
       global const real4 *Fs, real hourglass
 #define VB_LATTICE_ARGS \
   E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity, damping, origin, tissue_of, materials, Qs, Fs, hourglass
-// Indenter: position where forces are evaluated, position for the end-of-stage projection,
-// plate normal, velocity, radius (< 0: plate). Ignored when VB_INDENTER is 0.
-#define VB_INDENTER_PARAMS \
-  real4 ind_force_pos, real4 ind_proj_pos, real4 ind_normal, real4 ind_velocity, real ind_radius
+// Rigid indenters: a table of VB_INDENTERS rows (lattice frame, VB_IND_STRIDE reals each:
+// 0–2 start (m), 3 radius (m; < 0 for a plate), 4–6 plate normal into the tissue, 8–10
+// velocity (m/s), 12 travel time (s)), the time forces are evaluated at, and the time stage
+// positions are projected at. A 1-element placeholder when VB_INDENTERS is 0.
+#define VB_IND_STRIDE 16
+#define VB_INDENTER_PARAMS global const real *indenters, real t_force, real t_project
+#define VB_INDENTER_ARGS indenters, t_force, t_project

@@ -5,23 +5,21 @@
 //     (a(u, v) is recovered from ṽ, so no force buffer is stored).
 
 inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                          VB_LATTICE_PARAMS, real4 ind_pos, real4 ind_normal, real ind_radius) {
+                          VB_LATTICE_PARAMS, global const real* indenters, real t) {
   real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
 #if VB_GLOBAL_DAMPING
   f -= damping * xyz0(vi) / ui.w;
 #endif
-#if VB_INDENTER
-  const real4 x = rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui);
-  contact_constrain(&f, x, ind_pos, ind_normal, ind_radius, h);
+#if VB_INDENTERS
+  contact_constrain_all(&f, rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui), indenters, t, h);
 #endif
   return f * ui.w;
 }
 
 inline void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_of, int sy, int sz,
-                         real4 origin, real h, VB_INDENTER_PARAMS) {
-#if VB_INDENTER
-  contact_project(un, vn, rest_position(cell_of[e], sy, sz, origin, h), ind_proj_pos, ind_normal,
-                  ind_radius, ind_velocity);
+                         real4 origin, real h, global const real* indenters, real t) {
+#if VB_INDENTERS
+  contact_project_all(un, vn, rest_position(cell_of[e], sy, sz, origin, h), indenters, t);
 #endif
 }
 
@@ -32,11 +30,10 @@ kernel void euler_step(global const real4* u, global const real4* v, global real
   if (e >= n) return;
   real4 ui = u[e], vi = v[e];
   if (ui.w != 0) {
-    const real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, ind_force_pos, ind_normal, ind_radius);
+    const real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force);
     vi += dt * a;
     ui += dt * xyz0(vi);
-    finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, ind_force_pos, ind_proj_pos, ind_normal,
-                 ind_velocity, ind_radius);
+    finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, indenters, t_project);
   }
   u_out[e] = ui;
   v_out[e] = vi;
@@ -49,11 +46,10 @@ kernel void heun_predict(global const real4* u, global const real4* v, global re
   if (e >= n) return;
   real4 ui = u[e], vi = v[e];
   if (ui.w != 0) {
-    const real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, ind_force_pos, ind_normal, ind_radius);
+    const real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force);
     ui += dt * xyz0(vi);
     vi += dt * a;
-    finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, ind_force_pos, ind_proj_pos, ind_normal,
-                 ind_velocity, ind_radius);
+    finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, indenters, t_project);
   }
   u_pred[e] = ui;
   v_pred[e] = vi;
@@ -67,12 +63,10 @@ kernel void heun_correct(global real4* u, global real4* v, global const real4* u
   real4 ui = u[e];
   if (ui.w == 0) return;
   const real4 vi = v[e], up = u_pred[e], vp = v_pred[e];
-  const real4 a = acceleration(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, ind_force_pos, ind_normal,
-                               ind_radius);
+  const real4 a = acceleration(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t_force);
   real4 vn = xyz0((vi + vp) * (real)0.5 + (real)0.5 * dt * a);
   ui += (real)0.5 * dt * xyz0(vi + vp);
-  finish_stage(e, &ui, &vn, cell_of, sy, sz, origin, h, ind_force_pos, ind_proj_pos, ind_normal,
-               ind_velocity, ind_radius);
+  finish_stage(e, &ui, &vn, cell_of, sy, sz, origin, h, indenters, t_project);
   u[e] = ui;
   v[e] = vn;
 }

@@ -72,42 +72,57 @@ inline real4 static_force(uint e, real4 ui, real4 vi, global const real4* u, glo
   return f;
 }
 
-#if VB_INDENTER
-// Signed distance from the indenter surface (m, < 0 inside) and the outward contact normal.
-inline real indenter_distance(real4 x, real4 position, real4 normal, real radius, real4* n_out) {
-  if (radius < 0) {  // plate
-    *n_out = normal;
-    return dot3(x - position, normal);
+#if VB_INDENTERS
+inline real4 indenter_position(global const real* ind, real t) {
+  const real tt = fmin(t, ind[12]);
+  return (real4)(ind[0] + ind[8] * tt, ind[1] + ind[9] * tt, ind[2] + ind[10] * tt, 0);
+}
+
+inline real4 indenter_velocity(global const real* ind, real t) {
+  return t < ind[12] ? (real4)(ind[8], ind[9], ind[10], 0) : (real4)(0);
+}
+
+// Signed distance from the indenter surface at time t (m, < 0 inside) and the outward normal.
+inline real indenter_distance(real4 x, global const real* ind, real t, real4* n_out) {
+  const real4 p = indenter_position(ind, t);
+  if (ind[3] < 0) {  // plate
+    *n_out = (real4)(ind[4], ind[5], ind[6], 0);
+    return dot3(x - p, *n_out);
   }
-  const real4 d = xyz0(x - position);
+  const real4 d = xyz0(x - p);
   const real dist = length(d);
   *n_out = dist > 0 ? d / dist : (real4)(0, 0, 1, 0);
-  return dist - radius;
+  return dist - ind[3];
 }
 
 // Frictionless unilateral contact: a touching element cannot be pushed into the indenter, so the
 // inward normal part of its force is carried by the indenter. Returns that part (force on the
 // indenter, N) and removes it from f.
-inline real4 contact_constrain(real4* f, real4 x, real4 position, real4 normal, real radius,
-                               real h) {
+inline real4 contact_constrain(real4* f, real4 x, global const real* ind, real t, real h) {
   real4 n;
-  const real dist = indenter_distance(x, position, normal, radius, &n);
+  const real dist = indenter_distance(x, ind, t, &n);
   const real fn = dot3(*f, n);
   if (dist > REAL_CONTACT_TOL * h || fn >= 0) return (real4)(0);
   *f -= fn * n;
   return fn * n;
 }
 
-// Moves an element that ended inside the indenter back onto its surface; its normal velocity
+inline void contact_constrain_all(real4* f, real4 x, global const real* indenters, real t, real h) {
+  for (int i = 0; i < VB_INDENTERS; ++i) contact_constrain(f, x, indenters + VB_IND_STRIDE * i, t, h);
+}
+
+// Moves an element that ended inside an indenter back onto its surface; its normal velocity
 // becomes at least the indenter's.
-inline void contact_project(real4* ui, real4* vi, real4 X, real4 position, real4 normal,
-                            real radius, real4 velocity) {
-  real4 n;
-  const real dist = indenter_distance(X + xyz0(*ui), position, normal, radius, &n);
-  if (dist >= 0) return;
-  *ui -= dist * n;
-  const real vn = dot3(*vi, n), wn = dot3(velocity, n);
-  if (vn < wn) *vi += (wn - vn) * n;
+inline void contact_project_all(real4* ui, real4* vi, real4 X, global const real* indenters, real t) {
+  for (int i = 0; i < VB_INDENTERS; ++i) {
+    global const real* ind = indenters + VB_IND_STRIDE * i;
+    real4 n;
+    const real dist = indenter_distance(X + xyz0(*ui), ind, t, &n);
+    if (dist >= 0) continue;
+    *ui -= dist * n;
+    const real vn = dot3(*vi, n), wn = dot3(indenter_velocity(ind, t), n);
+    if (vn < wn) *vi += (wn - vn) * n;
+  }
 }
 #endif
 

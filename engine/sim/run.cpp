@@ -58,7 +58,8 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
   const double h = lattice.spacing_m;
   const double extent = h * Eigen::Vector3d(lattice.dims[0], lattice.dims[1], lattice.dims[2]).norm();
   const double tol = scene.stop.equilibrium;
-  const double travel_end = scene.indenters.empty() ? 0.0 : scene.indenters.front().travel_time_s;
+  double travel_end = 0;  // equilibrium only counts once every indenter has stopped
+  for (const IndenterSpec& ind : scene.indenters) travel_end = std::max(travel_end, ind.travel_time_s);
   const std::int64_t check_every = std::max(1, scene.solver.check_every);
   const std::int64_t frames_every = scene.output.frames_every;
   std::int64_t max_steps = scene.stop.max_steps;
@@ -89,14 +90,15 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
       out.frames.time_s.push_back(sim.time_s());
       out.frames.displacement_m.emplace_back(u.begin(), u.end());
     }
-    if (!scene.indenters.empty()) {
-      IndenterResult& ir = s.indenters.empty() ? s.indenters.emplace_back() : s.indenters.front();
-      const Vec3 pos = sim.indenter_position(sim.time_s());
-      ir.position_m = pos;
-      ir.reaction_force_n = c.indenter_force_n;
-      ir.contact_elements = c.contact_elements;
-      const double travel = (pos - scene.indenters.front().start_m).norm();
-      ir.history.push_back({sim.time_s(), c.indenter_force_n.x(), c.indenter_force_n.y(), c.indenter_force_n.z(), travel});
+    s.indenters.resize(scene.indenters.size());
+    for (std::size_t i = 0; i < scene.indenters.size(); ++i) {
+      IndenterResult& ir = s.indenters[i];
+      ir.position_m = sim.indenter_position(i, sim.time_s());
+      ir.reaction_force_n = c.indenter_force_n[i];
+      ir.contact_elements = c.contact_elements[i];
+      const double travel = (ir.position_m - scene.indenters[i].start_m).norm();
+      const Vec3& f = ir.reaction_force_n;
+      ir.history.push_back({sim.time_s(), f.x(), f.y(), f.z(), travel});
     }
     if (progress) progress({sim.steps(), max_steps, sim.time_s(), s.final_residual, s.final_speed_ratio});
     const bool settled = tol > 0 && s.final_residual <= tol && s.final_speed_ratio <= tol && sim.time_s() >= travel_end;

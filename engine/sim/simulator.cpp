@@ -11,9 +11,10 @@ namespace vb {
 namespace {
 
 constexpr int kCheckWorkGroup = 128;
-constexpr int kCheckSlots = 9;  // must match VB_CHECK_SLOTS in kernels/checks.cl
+constexpr int kCheckBaseSlots = 5, kCheckSlotsPerIndenter = 4;  // kernels/checks.cl
+constexpr int kIndenterStride = 16;                                // VB_IND_STRIDE
 // Kernel argument layout (kernels/common.cl): VB_LATTICE_PARAMS then VB_INDENTER_PARAMS.
-constexpr int kLatticeArgs = 15, kIndenterArgs = 5;
+constexpr int kLatticeArgs = 15, kIndenterArgs = 3;
 constexpr int kStepLattice = 4;                              // step kernels: 4 state buffers first
 constexpr int kStepIndenter = kStepLattice + kLatticeArgs;   // then dt, n
 constexpr int kCheckLattice = 2;                             // check_state: u, v first
@@ -62,7 +63,6 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   require(precision_ == Precision::Float || cl.info.fp64,
           "double precision requested but device '" + cl.info.name + "' has no fp64 support",
           "solver.precision", "use precision = \"float\" or another device");
-  require(scene.indenters.size() <= 1, "at most one indenter is supported in this version", "indenter");
   dt_ = choose_time_step(scene, lattice, el);
   require(dt_.dt_s > 0 && std::isfinite(dt_.dt_s), "time step must be positive and finite", "solver.dt");
 
@@ -112,7 +112,9 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   check_groups_ = (n_ + wg - 1) / wg;
   global_ = cl::NDRange(check_groups_ * wg);
   local_ = cl.info.is_gpu ? cl::NDRange(wg) : cl::NullRange;  // PoCL picks faster sizes itself
-  partial_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * kCheckSlots * real_size_);
+  check_slots_ = kCheckBaseSlots + kCheckSlotsPerIndenter * int(scene.indenters.size());
+  partial_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * check_slots_ * real_size_);
+  make_indenter_table();
   partial_arg_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * sizeof(cl_int));
 
   // Only the features this scene uses are compiled in.
@@ -122,7 +124,8 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_GRAVITY=" + std::to_string(gravity);
   options += " -DVB_DASHPOT=" + std::to_string(scene.solver.dashpot_ratio > 0);
   options += " -DVB_GLOBAL_DAMPING=" + std::to_string(scene.solver.damping_per_s > 0);
-  options += " -DVB_INDENTER=" + std::to_string(!scene.indenters.empty());
+  options += " -DVB_INDENTERS=" + std::to_string(scene.indenters.size());
+  options += " -DVB_CHECK_SLOTS=" + std::to_string(check_slots_);
   options += " -DVB_RSQRT=" + std::to_string(cl.info.is_gpu);
   options += " -DVB_HYPER=" + std::to_string(el.hyperelastic);
   options += " -DVB_CHECK_WG=" + std::to_string(kCheckWorkGroup);
@@ -236,24 +239,37 @@ void Simulator::set_lattice_args(cl::Kernel& k, int a) {
   set_real(k, a + 14, scene_.solver.hourglass);
 }
 
-Vec3 Simulator::indenter_position(double t) const {
-  const IndenterSpec& ind = scene_.indenters.front();
+Vec3 Simulator::indenter_position(std::size_t i, double t) const {
+  const IndenterSpec& ind = scene_.indenters.at(i);
   return ind.start_m + ind.velocity_m_s * std::min(t, ind.travel_time_s);
 }
 
-void Simulator::set_indenter_args(cl::Kernel& k, int a, double t_force, double t_project) {
-  if (scene_.indenters.empty()) {
-    for (int i = 0; i < 4; ++i) set_world_vector(k, a + i, Vec3::Zero());
-    set_real(k, a + 4, 0.0);
-    return;
+void Simulator::make_indenter_table() {
+  // Rows in the lattice frame (kernels/common.cl, VB_INDENTER_PARAMS); a placeholder row if none.
+  std::vector<double> table(kIndenterStride * std::max<std::size_t>(1, scene_.indenters.size()), 0.0);
+  const Eigen::Matrix3d Rt = lattice_.rotation.transpose();
+  for (std::size_t i = 0; i < scene_.indenters.size(); ++i) {
+    const IndenterSpec& ind = scene_.indenters[i];
+    double* row = &table[kIndenterStride * i];
+    const Vec3 start = Rt * ind.start_m, normal = Rt * ind.normal, velocity = Rt * ind.velocity_m_s;
+    for (int c = 0; c < 3; ++c) row[c] = start[c], row[4 + c] = normal[c], row[8 + c] = velocity[c];
+    row[3] = ind.kind == IndenterSpec::Kind::Plate ? -1.0 : ind.radius_m;
+    row[12] = std::isfinite(ind.travel_time_s) ? ind.travel_time_s : 1e300;
   }
-  const IndenterSpec& ind = scene_.indenters.front();
-  const bool moving = t_project < ind.travel_time_s;
-  set_world_vector(k, a + 0, indenter_position(t_force));
-  set_world_vector(k, a + 1, indenter_position(t_project));
-  set_world_vector(k, a + 2, ind.normal);
-  set_world_vector(k, a + 3, moving ? ind.velocity_m_s : Vec3::Zero());
-  set_real(k, a + 4, ind.kind == IndenterSpec::Kind::Plate ? -1.0 : ind.radius_m);
+  const auto flags = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
+  if (precision_ == Precision::Double) {
+    indenters_ = cl::Buffer(cl_.context, flags, table.size() * sizeof(double), table.data());
+  } else {
+    for (double& x : table) x = std::min(x, 1e30);  // travel time "never" within float range
+    std::vector<float> t(table.begin(), table.end());
+    indenters_ = cl::Buffer(cl_.context, flags, t.size() * sizeof(float), t.data());
+  }
+}
+
+void Simulator::set_indenter_args(cl::Kernel& k, int a, double t_force, double t_project) {
+  k.setArg(a, indenters_);
+  set_real(k, a + 1, t_force);
+  set_real(k, a + 2, t_project);
 }
 
 void Simulator::enqueue(cl::Kernel& k) const { cl_.queue.enqueueNDRangeKernel(k, cl::NullRange, global_, local_); }
@@ -301,7 +317,7 @@ StateCheck Simulator::check() {
   set_indenter_args(check_, kCheckIndenter, time_s(), time_s());
   enqueue_stress(u_);
   enqueue_check();
-  std::vector<double> p(check_groups_ * kCheckSlots);
+  std::vector<double> p(check_groups_ * check_slots_);
   if (precision_ == Precision::Double) {
     cl_.queue.enqueueReadBuffer(partial_, CL_TRUE, 0, p.size() * sizeof(double), p.data());
   } else {
@@ -313,8 +329,10 @@ StateCheck Simulator::check() {
   cl_.queue.enqueueReadBuffer(partial_arg_, CL_TRUE, 0, arg.size() * sizeof(cl_int), arg.data());
 
   StateCheck c;
+  c.indenter_force_n.assign(scene_.indenters.size(), Vec3::Zero());
+  c.contact_elements.assign(scene_.indenters.size(), 0);
   for (std::size_t g = 0; g < check_groups_; ++g) {
-    const double* q = &p[g * kCheckSlots];
+    const double* q = &p[g * check_slots_];
     c.max_residual_n = std::max(c.max_residual_n, q[0]);
     if (q[1] > c.max_speed_m_s || c.fastest_element < 0) {
       c.max_speed_m_s = q[1];
@@ -322,9 +340,12 @@ StateCheck Simulator::check() {
     }
     c.kinetic_energy_j += q[2];
     c.max_displacement_m = std::max(c.max_displacement_m, q[3]);
-    c.indenter_force_n += lattice_.rotation * Vec3(q[4], q[5], q[6]);
-    c.contact_elements += std::llround(q[7]);
-    c.nonfinite_elements += std::llround(q[8]);
+    c.nonfinite_elements += std::llround(q[4]);
+    for (std::size_t i = 0; i < scene_.indenters.size(); ++i) {
+      const double* r = q + kCheckBaseSlots + kCheckSlotsPerIndenter * i;
+      c.indenter_force_n[i] += lattice_.rotation * Vec3(r[0], r[1], r[2]);
+      c.contact_elements[i] += std::llround(r[3]);
+    }
   }
   return c;
 }

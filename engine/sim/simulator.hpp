@@ -19,8 +19,8 @@ struct StateCheck {
   double max_speed_m_s = 0;       ///< +inf when some value is not finite
   double kinetic_energy_j = 0;
   double max_displacement_m = 0;
-  Vec3 indenter_force_n = Vec3::Zero();  ///< force the tissue exerts on the indenter (N)
-  std::int64_t contact_elements = 0;
+  std::vector<Vec3> indenter_force_n;           ///< per indenter: force the tissue exerts on it (N)
+  std::vector<std::int64_t> contact_elements;   ///< per indenter: elements touching it
   std::int64_t nonfinite_elements = 0;
   std::int64_t fastest_element = -1;  ///< element with the largest speed (or first non-finite)
 };
@@ -48,8 +48,8 @@ class Simulator {
   std::int64_t steps() const { return steps_; }
   std::size_t device_bytes() const { return device_bytes_; }
   Precision precision() const { return precision_; }
-  /// indenter position at simulated time t (m); scene must have an indenter
-  Vec3 indenter_position(double t_s) const;
+  /// position of indenter i at simulated time t (m)
+  Vec3 indenter_position(std::size_t i, double t_s) const;
   const ClContext& context() const { return cl_; }
 
  private:
@@ -67,6 +67,7 @@ class Simulator {
   void enqueue_check() const;
   void enqueue_stress(const cl::Buffer& u);
   void make_hyperelastic_buffers(const ElementArrays& el);
+  void make_indenter_table();
   cl::Buffer make_state_buffer(const std::vector<double>& xyz, const std::vector<double>* w) const;
 
   const Scene& scene_;
@@ -85,7 +86,9 @@ class Simulator {
 
   cl::Buffer u_, v_, u_tmp_, v_tmp_, E_, cell_, grid_, partial_, partial_arg_;
   bool hyper_ = false;
-  cl::Buffer tissue_, materials_, Q_, F_;  ///< hyperelastic: tissue ids, law table, Q and F rows
+  cl::Buffer tissue_, materials_, Q_, F_;
+  cl::Buffer indenters_;  ///< indenter table (lattice frame)
+  int check_slots_ = 0;  ///< hyperelastic: tissue ids, law table, Q and F rows
   cl::Kernel stress_;
   cl::Program program_;
   cl::Kernel euler_, predict_, correct_;

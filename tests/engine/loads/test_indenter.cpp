@@ -65,7 +65,7 @@ TEST(Indenter, SphereIndenterPushesElementsOutOfItsVolume) {
   const auto m = test::make_model(s);
   Simulator sim(s, m.lattice, m.elements, test::cl_context());
   const RunOutput out = run_simulation(s, m.lattice, m.elements, sim);
-  const Vec3 centre = sim.indenter_position(sim.time_s());
+  const Vec3 centre = sim.indenter_position(0, sim.time_s());
   for (std::size_t e = 0; e < m.lattice.element_count(); ++e) {
     const Vec3 x(out.state.position_m[3 * e], out.state.position_m[3 * e + 1], out.state.position_m[3 * e + 2]);
     EXPECT_GE((x - centre).norm(), ball.radius_m * (1 - 1e-5)) << "element " << e << " inside the indenter";
