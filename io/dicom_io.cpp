@@ -5,6 +5,9 @@
 #include <dcmtk/dcmdata/dcdict.h>
 #include <dcmtk/dcmdata/dcfilefo.h>
 #include <dcmtk/dcmdata/dcmetinf.h>
+#include <dcmtk/dcmdata/dcpixel.h>
+#include <dcmtk/dcmdata/dcpixseq.h>
+#include <dcmtk/dcmdata/dcpxitem.h>
 #include <dcmtk/dcmdata/dcrledrg.h>
 #include <dcmtk/dcmdata/dcuid.h>
 #include <dcmtk/dcmdata/dcxfer.h>
@@ -12,6 +15,7 @@
 #include <dcmtk/dcmjpls/djdecode.h>
 #include <dcmtk/oflog/oflog.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -25,6 +29,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <sstream>
 
@@ -129,6 +134,258 @@ Uint16 get_uint16(DcmItem& item, const DcmTagKey& key, Uint16 fallback) {
   return item.findAndGetUint16(key, value).good() ? value : fallback;
 }
 
+// ---- deflated datasets -----------------------------------------------------------------------
+//
+// DCMTK reads a deflated dataset (Deflated Explicit VR Little Endian) through zlib, where it
+// cannot skip over a value to find the stream too short: it allocates each value as long as its
+// length field says before reading it (a 1 kB file can ask for 4 GiB). In a plain file it skips
+// large values and reads them on first access, so a false length only ends the parse. Hence a
+// deflated dataset is walked here first, inflated in a fixed buffer as DCMTK will inflate it:
+// every length it holds must be backed by inflated bytes before DCMTK reads it.
+
+/// Reads a raw deflate stream (RFC 1951, what DCMTK expects by default) from a file, inflating
+/// through a fixed buffer: nothing is kept, bytes are copied out or skipped.
+class InflatingReader {
+ public:
+  InflatingReader(std::ifstream& in) : in_(in) { ok_ = inflateInit2(&z_, -MAX_WBITS) == Z_OK; }
+  ~InflatingReader() { inflateEnd(&z_); }
+  InflatingReader(const InflatingReader&) = delete;
+  InflatingReader& operator=(const InflatingReader&) = delete;
+
+  /// Up to `n` bytes into `out` (skipped when null); fewer when the stream ends or is corrupt.
+  std::uint64_t read(unsigned char* out, std::uint64_t n) {
+    std::uint64_t done = 0;
+    while (done < n && (next_ < end_ || refill())) {
+      const std::size_t take = std::size_t(std::min<std::uint64_t>(n - done, end_ - next_));
+      if (out) std::memcpy(out + done, output_.data() + next_, take);
+      next_ += take;
+      done += take;
+    }
+    position_ += done;
+    return done;
+  }
+  std::uint64_t position() const { return position_; }
+
+ private:
+  bool refill() {
+    next_ = end_ = 0;
+    z_.next_out = output_.data();
+    z_.avail_out = uInt(output_.size());
+    while (ok_ && !ended_ && z_.avail_out == output_.size()) {
+      if (z_.avail_in == 0) {
+        in_.read(reinterpret_cast<char*>(input_.data()), std::streamsize(input_.size()));
+        z_.next_in = input_.data();
+        z_.avail_in = uInt(in_.gcount());
+        if (z_.avail_in == 0) ended_ = true;  // the file ends inside the stream
+      }
+      if (ended_) break;
+      const int status = inflate(&z_, Z_NO_FLUSH);
+      if (status == Z_STREAM_END) ended_ = true;
+      else if (status != Z_OK) ok_ = false;
+    }
+    end_ = output_.size() - z_.avail_out;
+    return end_ > 0;
+  }
+
+  std::ifstream& in_;
+  z_stream z_{};
+  bool ok_ = false, ended_ = false;
+  std::array<unsigned char, 16384> input_{}, output_{};
+  std::size_t next_ = 0, end_ = 0;
+  std::uint64_t position_ = 0;
+};
+
+/// Walks a deflated dataset's attributes (explicit VR little endian; implicit inside a UN value of
+/// undefined length, as DCMTK reads those), checking each length against the bytes there are and
+/// against the item or sequence holding it. Values are skipped, not read.
+class DeflatedDatasetWalk {
+ public:
+  explicit DeflatedDatasetWalk(InflatingReader& in) : in_(in) {}
+  bool dataset() { return elements(kUnbounded, true, Context::top, 0); }
+
+ private:
+  static constexpr std::uint64_t kUnbounded = ~std::uint64_t(0);
+  static constexpr std::uint32_t kUndefinedLength = 0xFFFFFFFF;
+  static constexpr int kMaxNesting = 64;
+  enum class Context { top, defined_item, undefined_item };
+
+  bool bytes(unsigned char* out, std::uint64_t n, std::uint64_t end) {
+    return in_.position() + n <= end && in_.read(out, n) == n;
+  }
+  bool number(std::uint32_t& value, int size, std::uint64_t end) {
+    unsigned char b[4] = {0, 0, 0, 0};
+    if (!bytes(b, std::uint64_t(size), end)) return false;
+    value = std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 |
+            std::uint32_t(b[3]) << 24;
+    return true;
+  }
+
+  /// Attributes until `end` (a defined length), an item delimiter (undefined-length item) or,
+  /// at the top, the end of the stream between two attributes.
+  bool elements(std::uint64_t end, bool explicit_vr, Context context, int depth) {
+    if (depth > kMaxNesting) return false;
+    while (true) {
+      if (context == Context::defined_item && in_.position() == end) return true;
+      unsigned char tag[4];
+      const std::uint64_t got = in_.position() + 4 <= end ? in_.read(tag, 4) : 0;
+      if (got == 0 && context == Context::top) return true;
+      if (got < 4) return false;
+      const unsigned group = tag[0] | tag[1] << 8, element = tag[2] | tag[3] << 8;
+      std::uint32_t length = 0;
+      if (group == 0xFFFE) {  // only an item delimiter belongs here
+        return element == 0xE00D && context == Context::undefined_item && number(length, 4, end);
+      }
+      char vr[2] = {0, 0};
+      if (explicit_vr) {
+        if (!bytes(reinterpret_cast<unsigned char*>(vr), 2, end)) return false;
+        const std::string name(vr, 2);
+        const bool long_length = name == "OB" || name == "OD" || name == "OF" || name == "OL" ||
+                                 name == "OV" || name == "OW" || name == "SQ" || name == "SV" ||
+                                 name == "UC" || name == "UN" || name == "UR" || name == "UT" ||
+                                 name == "UV";
+        std::uint32_t reserved = 0;
+        if (long_length ? !(number(reserved, 2, end) && number(length, 4, end))
+                        : !number(length, 2, end))
+          return false;
+      } else if (!number(length, 4, end)) {
+        return false;
+      }
+      const std::string name(vr, 2);
+      const bool pixel_data = group == 0x7FE0 && element == 0x0010;
+      if (length == kUndefinedLength) {
+        if (!explicit_vr || name == "SQ" || name == "UN") {
+          // a sequence; in an UN value its items are implicit VR (CP-246)
+          if (!sequence(end, explicit_vr && name == "SQ", pixel_data && !explicit_vr, depth + 1))
+            return false;
+        } else if (pixel_data && (name == "OB" || name == "OW")) {
+          if (!sequence(end, true, true, depth + 1)) return false;  // compressed fragments
+        } else {
+          return false;
+        }
+      } else if (explicit_vr && name == "SQ") {
+        const std::uint64_t sequence_end = in_.position() + length;
+        if (sequence_end > end || !defined_sequence(sequence_end, depth + 1)) return false;
+      } else if (!bytes(nullptr, length, end)) {
+        return false;
+      }
+    }
+  }
+
+  /// Items of a sequence of undefined length, up to its delimiter.
+  bool sequence(std::uint64_t end, bool explicit_vr, bool fragments, int depth) {
+    if (depth > kMaxNesting) return false;
+    while (true) {
+      std::uint32_t tag = 0, length = 0;
+      if (!number(tag, 4, end) || !number(length, 4, end)) return false;
+      if (tag == 0xE0DDFFFE) return true;  // sequence delimiter (FFFE,E0DD)
+      if (tag != 0xE000FFFE || !item(end, length, explicit_vr, fragments, depth)) return false;
+    }
+  }
+
+  /// Items of an explicit VR sequence of defined length, up to `end`.
+  bool defined_sequence(std::uint64_t end, int depth) {
+    while (in_.position() < end) {
+      std::uint32_t tag = 0, length = 0;
+      if (!number(tag, 4, end) || !number(length, 4, end)) return false;
+      if (tag == 0xE0DDFFFE) return in_.position() == end;
+      if (tag != 0xE000FFFE || !item(end, length, true, false, depth)) return false;
+    }
+    return true;
+  }
+
+  bool item(std::uint64_t end, std::uint32_t length, bool explicit_vr, bool fragment, int depth) {
+    if (length == kUndefinedLength)
+      return !fragment && elements(end, explicit_vr, Context::undefined_item, depth + 1);
+    const std::uint64_t item_end = in_.position() + length;
+    if (item_end > end) return false;
+    if (fragment) return bytes(nullptr, length, end);
+    return elements(item_end, explicit_vr, Context::defined_item, depth + 1);
+  }
+
+  InflatingReader& in_;
+};
+
+/// The transfer syntax in a Part 10 file's meta header (group 0002, explicit VR little endian
+/// after "DICM" at byte 128) and the offset where the dataset starts. nullopt when the meta header
+/// cannot be walked, or when its group length (0002,0000) disagrees with the walk (DCMTK ends the
+/// header by the group length: the two must agree on where the deflated stream starts).
+struct MetaHeader {
+  std::string transfer_syntax;
+  std::uint64_t dataset_offset = 0;
+};
+
+std::optional<MetaHeader> walk_meta_header(std::ifstream& in) {
+  std::array<char, 132> head{};
+  if (!in.read(head.data(), head.size()) || std::string(&head[128], 4) != "DICM")
+    return std::nullopt;
+  MetaHeader meta;
+  std::optional<std::uint64_t> group_end;
+  std::uint64_t at = 132;
+  while (true) {
+    unsigned char element[12] = {};
+    in.read(reinterpret_cast<char*>(element), 8);
+    if (in.gcount() < 8 || (element[0] | element[1] << 8) != 0x0002) break;
+    const unsigned number = element[2] | element[3] << 8;
+    const std::string vr(reinterpret_cast<char*>(element + 4), 2);
+    std::uint64_t length = element[6] | element[7] << 8, header = 8;
+    if (vr == "OB" || vr == "OW" || vr == "UN" || vr == "SQ" || vr == "UT" || vr == "UC" ||
+        vr == "UR") {
+      if (!in.read(reinterpret_cast<char*>(element + 8), 4)) return std::nullopt;
+      length = std::uint64_t(element[8]) | std::uint64_t(element[9]) << 8 |
+               std::uint64_t(element[10]) << 16 | std::uint64_t(element[11]) << 24;
+      header = 12;
+    }
+    if (length > 4096) return std::nullopt;  // no meta attribute is that long
+    std::string value(std::size_t(length), '\0');
+    if (!in.read(value.data(), std::streamsize(length))) return std::nullopt;
+    if (number == 0x0000 && length == 4)
+      group_end = at + header + 4 + (std::uint64_t(std::uint8_t(value[0])) |
+                                     std::uint64_t(std::uint8_t(value[1])) << 8 |
+                                     std::uint64_t(std::uint8_t(value[2])) << 16 |
+                                     std::uint64_t(std::uint8_t(value[3])) << 24);
+    if (number == 0x0010)  // UI values are padded with NUL, some writers pad with a space
+      meta.transfer_syntax = value.substr(0, value.find_last_not_of(std::string(" \0", 2)) + 1);
+    at += header + length;
+  }
+  if (group_end && *group_end != at) return std::nullopt;
+  meta.dataset_offset = at;
+  return meta;
+}
+
+/// For a file DCMTK would read as a deflated dataset: the walk above, before DCMTK reads it.
+void check_deflated_dataset(const std::string& path) {
+  // DCMTK's own reading of the meta header; it stops at the first dataset attribute, unread. A
+  // file it cannot read this far fails the same way when it is loaded, before any inflating.
+  DcmFileFormat probe;
+  if (probe
+          .loadFileUntilTag(path.c_str(), EXS_Unknown, EGL_noChange, DCM_MaxReadLength,
+                            ERM_autoDetect, DcmTagKey(0x0000, 0x0000))
+          .bad())
+    return;
+  // A transfer syntax UID is at most 64 bytes; a longer value is not one (and reading it would
+  // make DCMTK allocate its length).
+  DcmElement* uid = nullptr;
+  if (probe.getMetaInfo()->findAndGetElement(DCM_TransferSyntaxUID, uid).bad() || !uid ||
+      uid->getLengthField() > 64)
+    return;
+  const std::string syntax = get_text(*probe.getMetaInfo(), DCM_TransferSyntaxUID);
+  if (syntax.empty() || DcmXfer(syntax.c_str()).getStreamCompression() == ESC_none) return;
+
+  std::ifstream in(path, std::ios::binary);
+  const std::optional<MetaHeader> meta = walk_meta_header(in);
+  require(meta && meta->transfer_syntax == syntax,
+          "cannot parse DICOM file: malformed meta header before a deflated dataset", path,
+          kCorruptFileHint);
+  in.clear();
+  in.seekg(std::streamoff(meta->dataset_offset));
+  const bool positioned = bool(in);
+  InflatingReader inflated(in);
+  require(positioned && DeflatedDatasetWalk(inflated).dataset(),
+          "cannot parse DICOM file: the deflated dataset is corrupt or truncated (an attribute is "
+          "longer than the data that holds it)",
+          path, kCorruptFileHint);
+}
+
 // ---- scanning a folder -----------------------------------------------------------------------
 
 /// A DICOM file whose attributes up to (not including) the pixel data are loaded.
@@ -158,6 +415,7 @@ FileKind sniff(const std::string& path) {
 std::optional<DicomHeader> load_header(const std::string& path) {
   const FileKind kind = sniff(path);
   if (kind == FileKind::other) return std::nullopt;
+  if (kind == FileKind::part10) check_deflated_dataset(path);
   auto file = std::make_unique<DcmFileFormat>();
   const OFCondition status = file->loadFileUntilTag(
       path.c_str(), EXS_Unknown, EGL_noChange, DCM_MaxReadLength,
@@ -403,11 +661,186 @@ StackGeometry stack_geometry(const std::vector<const DicomHeader*>& files, bool 
 }
 
 // ---- pixel data ------------------------------------------------------------------------------
+//
+// A slice's pixel attributes and the size of its pixel data are checked before any memory is
+// committed to its pixels: before the volume is allocated (Rows × Columns × slices floats) and
+// before DCMTK decodes compressed data, since its decoders allocate their output from Rows,
+// Columns, SamplesPerPixel and BitsAllocated before they look at the compressed stream.
 
-/// Brings encapsulated (compressed) pixel data to native form with the registered decoders.
-void decompress(DcmDataset& data, const std::string& path) {
+/// Largest volume read: 2^31 voxels (8 GiB of float values).
+constexpr std::uint64_t kMaxVoxels = std::uint64_t(1) << 31;
+/// Compressed (encapsulated) pixel data may decode to at most kMaxCompressionRatio times the
+/// file's size, plus kCompressedAllowanceBytes for any file. Real CT slices compress far less;
+/// JPEG-LS can beat 1024:1 only on large uniform areas, and the allowance covers those for slices
+/// up to 4096 × 4096 at 16 bits. Without this bound a file of a few hundred bytes could make
+/// DCMTK's decoder allocate gigabytes.
+constexpr std::uint64_t kMaxCompressionRatio = 1024;
+constexpr std::uint64_t kCompressedAllowanceBytes = std::uint64_t(32) << 20;
+/// A deflated dataset (Deflated Explicit VR Little Endian) inflates at most 1032:1.
+constexpr std::uint64_t kMaxDeflateRatio = 1032;
+
+/// How one slice's pixels are stored: one frame, one sample per pixel.
+struct PixelLayout {
+  int bits_allocated = 0, bits_stored = 0;
+  bool is_signed = false;
+  std::uint64_t pixels = 0;  ///< Rows × Columns
+  std::uint64_t bytes = 0;   ///< pixels × BitsAllocated / 8
+};
+
+/// The Image Pixel attributes this reader supports; nothing is decoded or allocated yet.
+PixelLayout check_pixel_layout(DcmDataset& data, int rows, int columns, const std::string& path) {
+  require(get_uint16(data, DCM_Rows, 0) == rows && get_uint16(data, DCM_Columns, 0) == columns,
+          "Rows/Columns changed while the series was read", path);
+  const int samples = get_uint16(data, DCM_SamplesPerPixel, 1);
+  const std::string photometric = get_text(data, DCM_PhotometricInterpretation);
+  PixelLayout layout;
+  layout.bits_allocated = get_uint16(data, DCM_BitsAllocated, 0);
+  layout.bits_stored = get_uint16(data, DCM_BitsStored, Uint16(layout.bits_allocated));
+  const int high_bit = get_uint16(data, DCM_HighBit, Uint16(layout.bits_stored - 1));
+  layout.is_signed = get_uint16(data, DCM_PixelRepresentation, 0) == 1;
+  const double frames = get_number(data, DCM_NumberOfFrames).value_or(1);
+  require(samples == 1,
+          "only greyscale images (SamplesPerPixel 1) are supported, not SamplesPerPixel " +
+              std::to_string(samples),
+          path);
+  require(photometric == "MONOCHROME1" || photometric == "MONOCHROME2",
+          "only greyscale images (PhotometricInterpretation MONOCHROME1 or MONOCHROME2) are "
+          "supported, not '" +
+              photometric + "'",
+          path);
+  require(frames == 1, "multi-frame images are not supported", path,
+          "convert the series to one file per slice");
+  require((layout.bits_allocated == 8 || layout.bits_allocated == 16) && layout.bits_stored >= 1 &&
+              layout.bits_stored <= layout.bits_allocated && high_bit == layout.bits_stored - 1,
+          "unsupported pixel layout (BitsAllocated " + std::to_string(layout.bits_allocated) +
+              ", BitsStored " + std::to_string(layout.bits_stored) + ", HighBit " +
+              std::to_string(high_bit) + ")",
+          path);
+  layout.pixels = std::uint64_t(rows) * std::uint64_t(columns);
+  layout.bytes = layout.pixels * std::uint64_t(layout.bits_allocated / 8);
+  return layout;
+}
+
+std::string pixels_text(int rows, int columns, const PixelLayout& layout) {
+  return std::to_string(columns) + " x " + std::to_string(rows) + " pixels of " +
+         std::to_string(layout.bits_allocated) + " bits (" + std::to_string(layout.bytes) +
+         " bytes)";
+}
+
+/// Rows, columns and components of a JPEG or JPEG-LS stream, from its frame header (SOFn, or
+/// SOF55 for JPEG-LS); nullopt when none is found in `bytes` (not JPEG, or cut).
+struct FrameHeader {
+  int rows = 0, columns = 0, components = 0;
+};
+
+std::optional<FrameHeader> jpeg_frame_header(const Uint8* bytes, std::size_t size) {
+  if (size < 4 || bytes[0] != 0xFF || bytes[1] != 0xD8) return std::nullopt;  // SOI
+  std::size_t at = 2;
+  while (at + 4 <= size) {
+    if (bytes[at] != 0xFF) return std::nullopt;
+    const Uint8 marker = bytes[at + 1];
+    if (marker == 0xFF) {  // fill byte
+      ++at;
+      continue;
+    }
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD8)) {  // TEM, RSTn, SOI: no length
+      at += 2;
+      continue;
+    }
+    if (marker == 0xD9 || marker == 0xDA) return std::nullopt;  // EOI or SOS before a frame
+    const bool frame = (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
+                        marker != 0xCC) ||
+                       marker == 0xF7;
+    if (frame) {
+      if (at + 10 > size) return std::nullopt;
+      // FF Cn, Lf (2), P (1), Y (2), X (2), Nf (1)
+      return FrameHeader{bytes[at + 5] << 8 | bytes[at + 6], bytes[at + 7] << 8 | bytes[at + 8],
+                         bytes[at + 9]};
+    }
+    at += 2 + (std::size_t(bytes[at + 2]) << 8 | bytes[at + 3]);
+  }
+  return std::nullopt;
+}
+
+/// DCMTK's decoders size their output from Rows and Columns and decode whatever the stream holds
+/// into it: a JPEG or JPEG-LS frame of another size would be read as garbage without an error.
+/// So the first fragment's frame header must agree with the dataset (a height of 0, "defined
+/// later by a DNL marker", is left to the decoder).
+void check_compressed_frame(DcmElement& pixel_data, const PixelLayout& layout, int rows,
+                            int columns, const std::string& path) {
+  auto* pixels = dynamic_cast<DcmPixelData*>(&pixel_data);
+  E_TransferSyntax syntax = EXS_Unknown;
+  const DcmRepresentationParameter* parameter = nullptr;
+  DcmPixelSequence* sequence = nullptr;
+  DcmPixelItem* fragment = nullptr;
+  Uint8* bytes = nullptr;
+  if (pixels) pixels->getOriginalRepresentationKey(syntax, parameter);
+  const bool found = pixels &&
+                     pixels->getEncapsulatedRepresentation(syntax, parameter, sequence).good() &&
+                     sequence && sequence->getItem(fragment, 1).good() && fragment &&
+                     fragment->getUint8Array(bytes).good() && bytes;
+  require(found, "no compressed pixel data fragment", path, kCorruptFileHint);
+  const std::optional<FrameHeader> frame = jpeg_frame_header(bytes, fragment->getLength());
+  if (!frame) return;  // not JPEG (RLE has no frame size): the decoded length is checked later
+  require(frame->columns == columns && (frame->rows == rows || frame->rows == 0) &&
+              frame->components == 1,
+          "the compressed frame is " + std::to_string(frame->columns) + " x " +
+              std::to_string(frame->rows) + " pixels with " + std::to_string(frame->components) +
+              " component(s), the header says " + pixels_text(rows, columns, layout),
+          path, kCorruptFileHint);
+}
+
+/// The pixel data's size against the layout, from its length field (native) or the file size
+/// (compressed): the value itself is not loaded (DCMTK loads large values on first access).
+void check_pixel_data_size(DcmDataset& data, const PixelLayout& layout, int rows, int columns,
+                           const std::string& path) {
+  DcmElement* pixel_data = nullptr;
+  require(data.findAndGetElement(DCM_PixelData, pixel_data).good() && pixel_data != nullptr,
+          "no pixel data", path, kCorruptFileHint);
+  std::error_code ec;
+  const std::uint64_t file_size = fs::file_size(path, ec);
+  require(!ec, "cannot read the file size: " + ec.message(), path);
   const DcmXfer syntax(data.getOriginalXfer());
-  if (!syntax.isEncapsulated()) return;
+  if (syntax.isEncapsulated()) {
+    require(layout.bytes <= kCompressedAllowanceBytes + kMaxCompressionRatio * file_size,
+            "compressed pixel data in a file of " + std::to_string(file_size) +
+                " bytes cannot hold " + pixels_text(rows, columns, layout),
+            path, kCorruptFileHint);
+    check_compressed_frame(*pixel_data, layout, rows, columns, path);
+    return;
+  }
+  const std::uint64_t length = pixel_data->getLengthField();
+  require(length >= layout.bytes,
+          "pixel data too short: " + std::to_string(length) + " bytes for " +
+              pixels_text(rows, columns, layout),
+          path, "the file may be truncated");
+  const bool deflated = syntax.getStreamCompression() != ESC_none;
+  require(length / (deflated ? kMaxDeflateRatio : 1) <= file_size,
+          "pixel data of " + std::to_string(length) + " bytes in a file of " +
+              std::to_string(file_size) + " bytes",
+          path, kCorruptFileHint);
+}
+
+/// A slice file (values of large elements are loaded on access) whose pixel attributes and pixel
+/// data size have been checked.
+std::unique_ptr<DcmFileFormat> load_slice(const std::string& path, int rows, int columns,
+                                          PixelLayout& layout) {
+  check_deflated_dataset(path);
+  auto file = std::make_unique<DcmFileFormat>();
+  const OFCondition status = file->loadFile(path.c_str());
+  require(status.good(), std::string("cannot read DICOM file: ") + status.text(), path,
+          kCorruptFileHint);
+  DcmDataset& data = *file->getDataset();
+  layout = check_pixel_layout(data, rows, columns, path);
+  check_pixel_data_size(data, layout, rows, columns, path);
+  return file;
+}
+
+/// Brings encapsulated (compressed) pixel data to native form with the registered decoders;
+/// true when there was something to decode.
+bool decompress(DcmDataset& data, const std::string& path) {
+  const DcmXfer syntax(data.getOriginalXfer());
+  if (!syntax.isEncapsulated()) return false;
   const bool decoded = data.chooseRepresentation(EXS_LittleEndianExplicit, nullptr).good() &&
                        data.canWriteXfer(EXS_LittleEndianExplicit);
   require(decoded,
@@ -416,6 +849,7 @@ void decompress(DcmDataset& data, const std::string& path) {
           path,
           "supported: uncompressed, deflated, JPEG baseline/extended/lossless, JPEG-LS, RLE; "
           "convert the series first (e.g. gdcmconv --raw)");
+  return true;
 }
 
 /// Stored value of a pixel: the low `bits_stored` bits, two's complement when signed.
@@ -426,60 +860,50 @@ std::int64_t stored_value(std::uint32_t raw, int bits_stored, bool is_signed) {
   return negative ? value - (std::int64_t(1) << bits_stored) : value;
 }
 
-/// The native pixel array (8 or 16 bits allocated) widened to 32 bits.
-std::vector<std::uint32_t> raw_pixels(DcmDataset& data, int bits_allocated,
-                                      const std::string& path) {
-  unsigned long count = 0;
+/// The native pixel array: `count` values of 8 or 16 bits (no copy).
+template <class T>
+const T* native_pixels(DcmDataset& data, unsigned long& count, const std::string& path) {
+  const T* values = nullptr;
   OFCondition status;
-  std::vector<std::uint32_t> pixels;
-  if (bits_allocated == 16) {
-    const Uint16* values = nullptr;
+  if constexpr (sizeof(T) == 2)
     status = data.findAndGetUint16Array(DCM_PixelData, values, &count);
-    if (status.good() && values) pixels.assign(values, values + count);
-  } else {
-    const Uint8* values = nullptr;
+  else
     status = data.findAndGetUint8Array(DCM_PixelData, values, &count);
-    if (status.good() && values) pixels.assign(values, values + count);
-  }
-  require(status.good() && !pixels.empty(), "no readable pixel data", path);
-  return pixels;
+  require(status.good() && values != nullptr && count > 0, "no readable pixel data", path,
+          kCorruptFileHint);
+  return values;
 }
 
 /// Decodes one slice's pixels into `out` (rows × columns, column index fastest) in rescaled units.
 void read_slice_pixels(const std::string& path, int rows, int columns, float* out) {
-  DcmFileFormat file;
-  const OFCondition status = file.loadFile(path.c_str());
-  require(status.good(), std::string("cannot read DICOM file: ") + status.text(), path,
-          kCorruptFileHint);
-  DcmDataset& data = *file.getDataset();
-  decompress(data, path);
-
-  const int samples = get_uint16(data, DCM_SamplesPerPixel, 1);
-  const int bits_allocated = get_uint16(data, DCM_BitsAllocated, 0);
-  const int bits_stored = get_uint16(data, DCM_BitsStored, Uint16(bits_allocated));
-  const int high_bit = get_uint16(data, DCM_HighBit, Uint16(bits_stored - 1));
-  const bool is_signed = get_uint16(data, DCM_PixelRepresentation, 0) == 1;
-  const double frames = get_number(data, DCM_NumberOfFrames).value_or(1);
-  require(samples == 1, "only greyscale images (SamplesPerPixel 1) are supported", path);
-  require(frames == 1, "multi-frame images are not supported", path,
-          "convert the series to one file per slice");
-  require((bits_allocated == 8 || bits_allocated == 16) && bits_stored >= 1 &&
-              bits_stored <= bits_allocated && high_bit == bits_stored - 1,
-          "unsupported pixel layout (BitsAllocated " + std::to_string(bits_allocated) +
-              ", BitsStored " + std::to_string(bits_stored) + ", HighBit " +
-              std::to_string(high_bit) + ")",
-          path);
-
-  const std::vector<std::uint32_t> raw = raw_pixels(data, bits_allocated, path);
-  const std::size_t count = std::size_t(rows) * std::size_t(columns);
-  require(raw.size() >= count,
-          "pixel data too short: " + std::to_string(raw.size()) + " of " + std::to_string(count) +
-              " pixels",
-          path, "the file may be truncated");
+  PixelLayout layout;
+  const std::unique_ptr<DcmFileFormat> file = load_slice(path, rows, columns, layout);
+  DcmDataset& data = *file->getDataset();
+  const bool decoded = decompress(data, path);
   const double slope = get_number(data, DCM_RescaleSlope).value_or(1.0);
   const double intercept = get_number(data, DCM_RescaleIntercept).value_or(0.0);
-  for (std::size_t n = 0; n < count; ++n)
-    out[n] = float(double(stored_value(raw[n], bits_stored, is_signed)) * slope + intercept);
+
+  const auto convert = [&](auto tag) {
+    using T = decltype(tag);
+    unsigned long count = 0;
+    const T* raw = native_pixels<T>(data, count, path);
+    // A decoder's output must be exactly one frame (8 bits: padded to even length); native data
+    // was checked against its length field already.
+    const std::uint64_t pixels = layout.pixels;
+    const bool exact =
+        count == pixels || (sizeof(T) == 1 && pixels % 2 == 1 && count == pixels + 1);
+    require(decoded ? exact : count >= pixels,
+            "pixel data holds " + std::to_string(count) + " values for " +
+                pixels_text(rows, columns, layout),
+            path, kCorruptFileHint);
+    for (std::uint64_t n = 0; n < pixels; ++n)
+      out[n] = float(double(stored_value(raw[n], layout.bits_stored, layout.is_signed)) * slope +
+                     intercept);
+  };
+  if (layout.bits_allocated == 16)
+    convert(Uint16{});
+  else
+    convert(Uint8{});
 }
 
 void carry_tags(DcmDataset& data, ImageVolume& volume) {
@@ -740,17 +1164,9 @@ std::string slice_file_name(int k) {
   return name;
 }
 
-}  // namespace
-
-std::vector<DicomSeriesInfo> list_dicom_series(const std::string& dir) {
-  const std::vector<DicomHeader> headers = scan_folder(dir);
-  std::vector<DicomSeriesInfo> infos;
-  for (const auto& [uid, files] : group_by_series(headers)) infos.push_back(describe(uid, files));
-  return infos;
-}
-
-ImageVolume read_dicom_series(const std::string& dir, const DicomReadOptions& options,
-                              std::vector<std::string>* warnings) {
+/// read_dicom_series without its guard against running out of memory.
+ImageVolume read_series(const std::string& dir, const DicomReadOptions& options,
+                        std::vector<std::string>* warnings) {
   const std::vector<DicomHeader> headers = scan_folder(dir);
   const SeriesMap series = group_by_series(headers);
   const auto& files = choose_series(series, options.series_uid, dir);
@@ -765,6 +1181,19 @@ ImageVolume read_dicom_series(const std::string& dir, const DicomReadOptions& op
   std::vector<std::string> stack_warnings;
   const StackGeometry stack = stack_geometry(files, options.allow_gaps, stack_warnings);
   volume.dims = {stack.columns, stack.rows, int(stack.files.size())};
+  const std::uint64_t voxels =
+      std::uint64_t(stack.columns) * std::uint64_t(stack.rows) * stack.files.size();
+  require(voxels <= kMaxVoxels,
+          "the series has " + std::to_string(voxels) + " voxels (" +
+              std::to_string(stack.columns) + " x " + std::to_string(stack.rows) + " x " +
+              std::to_string(stack.files.size()) + "), more than the " +
+              std::to_string(kMaxVoxels) + " read",
+          dir, "crop or downsample the series first");
+  // Every slice's pixel attributes and pixel data size, before memory is committed to the volume.
+  for (const DicomHeader* file : stack.files) {
+    PixelLayout layout;
+    load_slice(file->path, stack.rows, stack.columns, layout);
+  }
   volume.affine_lps_m = stack.affine_lps_m;
   volume.values.resize(volume.voxel_count());
   for (int k = 0; k < volume.dims[2]; ++k)
@@ -773,6 +1202,33 @@ ImageVolume read_dicom_series(const std::string& dir, const DicomReadOptions& op
   carry_tags(stack.files.front()->data(), volume);
   if (warnings) warnings->insert(warnings->end(), stack_warnings.begin(), stack_warnings.end());
   return volume;
+}
+
+/// Runs a reader of the folder `dir`; running out of memory is a vb::Error naming the folder.
+template <class Read>
+auto guard_memory(const std::string& dir, Read&& read) {
+  try {
+    return read();
+  } catch (const std::bad_alloc&) {
+    throw Error("not enough memory to read the DICOM series", dir,
+                "free memory, or crop or downsample the series first");
+  }
+}
+
+}  // namespace
+
+std::vector<DicomSeriesInfo> list_dicom_series(const std::string& dir) {
+  return guard_memory(dir, [&] {
+    const std::vector<DicomHeader> headers = scan_folder(dir);
+    std::vector<DicomSeriesInfo> infos;
+    for (const auto& [uid, files] : group_by_series(headers)) infos.push_back(describe(uid, files));
+    return infos;
+  });
+}
+
+ImageVolume read_dicom_series(const std::string& dir, const DicomReadOptions& options,
+                              std::vector<std::string>* warnings) {
+  return guard_memory(dir, [&] { return read_series(dir, options, warnings); });
 }
 
 ImageVolume read_dicom_series(const std::string& dir, const std::string& series_uid,

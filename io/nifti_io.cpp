@@ -8,9 +8,13 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
+#include <new>
+#include <optional>
 #include <string>
 #include <system_error>
 #include <type_traits>
@@ -29,7 +33,11 @@ struct NiftiFree {
 };
 using NiftiPtr = std::unique_ptr<nifti_image, NiftiFree>;
 
-/// nifti_clib prints its own diagnostics to stderr; ours (vb::Error) say more, so silence it.
+/// Debug level 0 silences nifti_clib's debug and warning output, but not all of its messages: some
+/// error paths (header conversion, a seek past the end of the file) print "** ..." to stderr at
+/// any level. read_raw_header and require_voxel_bytes refuse the inputs known to lead there before
+/// nifti_clib sees them, so such lines should be rare (a fuzzing run printed none), not impossible.
+/// The caller gets our vb::Error either way.
 void quiet_nifti_clib() {
   static const bool quiet = (nifti_set_debug_level(0), true);
   (void)quiet;
@@ -104,28 +112,266 @@ std::string voxel_name(const std::array<int, 3>& dims, std::size_t index) {
          std::to_string(index / (nx * ny)) + ")";
 }
 
+// ---- reading: our own header checks, before nifti_clib sees the file -------------------------
+//
+// nifti_clib 3.0.1 trusts the header: nifti_convert_n2hdr2nim copies dim[0] + 1 entries of a
+// NIfTI-2 dim[] into its 8-entry array (stack corruption for dim[0] > 7), and nifti_image_load
+// allocates nvox × nbyper bytes before it reads any of them (4 GB for a 360-byte file). So the
+// raw header is read (through znzlib, as nifti_clib reads it) and checked here first, together
+// with the file's size; nifti_image_read only ever sees headers that passed.
+
+/// Largest image read: 2^31 stored values (8 GiB as float).
+constexpr std::uint64_t kMaxVoxels = std::uint64_t(1) << 31;
+/// Deflate never expands more than 1032:1 (a 258-byte match coded in 2 bits).
+constexpr std::uint64_t kMaxDeflateRatio = 1032;
+constexpr std::size_t kNifti1HeaderSize = sizeof(nifti_1_header);
+constexpr std::size_t kNifti2HeaderSize = sizeof(nifti_2_header);
+static_assert(kNifti1HeaderSize == 348 && kNifti2HeaderSize == 540);
+constexpr const char* kNotNifti = "not a readable NIfTI file";
+constexpr const char* kCompleteFileHint = "check that the file is a complete .nii or .nii.gz file";
+constexpr const char* kCorruptFileHint =
+    "the file is incomplete or corrupt; write or download it again";
+
+/// The header fields we rely on, in host byte order, as stored in the file.
+struct RawHeader {
+  int version = 0;          ///< 1 or 2
+  bool single_file = true;  ///< magic n+1 / n+2: the voxels are in the same file
+  std::array<std::int64_t, 8> dim{};
+  int datatype = 0;
+  std::size_t bytes_per_voxel = 0;
+  std::array<double, 8> pixdim{};  ///< as stored: nifti_image's copy has zeros replaced by 1
+  std::int64_t vox_offset = 0;
+  std::uint64_t voxels = 0;  ///< dim[1] × … × dim[dim[0]]
+};
+
+std::uint32_t byte_swapped(std::uint32_t v) {
+  return (v >> 24) | ((v >> 8) & 0xff00u) | ((v << 8) & 0xff0000u) | (v << 24);
+}
+
+/// 1 or 2 for a sizeof_hdr of 348 or 540, else 0.
+int version_of_size(std::uint32_t sizeof_hdr) {
+  if (sizeof_hdr == kNifti1HeaderSize) return 1;
+  return sizeof_hdr == kNifti2HeaderSize ? 2 : 0;
+}
+
+/// znzread of bytes: how many were read, nullopt on an error (a corrupt gzip stream; znzread
+/// passes gzread's -1 on as a huge size_t).
+std::optional<std::size_t> znz_read_bytes(void* buffer, std::size_t bytes, znzFile file) {
+  const std::size_t got = znzread(buffer, 1, bytes, file);
+  if (got > bytes) return std::nullopt;
+  return got;
+}
+
+/// The gzip magic (1f 8b) at the start, and the ISIZE trailer: the uncompressed size modulo 2^32
+/// of the last gzip member (RFC 1952), read from the last 4 bytes.
+std::optional<std::uint32_t> gzip_isize(const std::string& file, std::uint64_t size) {
+  std::ifstream in(file, std::ios::binary);
+  unsigned char magic[2] = {0, 0}, trailer[4] = {0, 0, 0, 0};
+  in.read(reinterpret_cast<char*>(magic), 2);
+  if (!in || magic[0] != 0x1f || magic[1] != 0x8b || size < 18) return std::nullopt;
+  in.seekg(std::streamoff(size - 4));
+  in.read(reinterpret_cast<char*>(trailer), 4);
+  if (!in) return std::nullopt;
+  return std::uint32_t(trailer[0]) | std::uint32_t(trailer[1]) << 8 |
+         std::uint32_t(trailer[2]) << 16 | std::uint32_t(trailer[3]) << 24;
+}
+
+/// Decompresses `file` through znzlib and counts its bytes, stopping at `needed`: no large buffer.
+bool gzip_stream_has(const std::string& file, std::uint64_t needed) {
+  znzFile in = znzopen(file.c_str(), "rb", 1);
+  if (znz_isnull(in)) return false;
+  std::vector<char> buffer(std::size_t(1) << 16);
+  std::uint64_t count = 0;
+  while (count < needed) {
+    const std::optional<std::size_t> got = znz_read_bytes(buffer.data(), buffer.size(), in);
+    if (!got || *got == 0) break;
+    count += *got;
+  }
+  znzclose(in);
+  return count >= needed;
+}
+
+/// Whether `file`, read through znzlib as nifti_clib reads it (gzip for a .gz name), holds at
+/// least `needed` bytes. Plain: its size. Gzip: deflate expands at most 1032:1, which bounds what
+/// a small file can claim; then the ISIZE trailer settles it cheaply when it is large enough.
+/// ISIZE can say too little for a valid file (one over 4 GiB, where it wraps around, or one made
+/// of several gzip members, where it counts only the last): then the stream is decompressed and
+/// counted up to `needed`, once more than reading it costs, in such files only.
+bool file_holds(const std::string& file, std::int64_t offset, std::uint64_t data_bytes) {
+  std::error_code ec;
+  const std::uint64_t size = std::filesystem::file_size(file, ec);
+  if (ec || offset < 0) return false;
+  const std::uint64_t needed = std::uint64_t(offset) + data_bytes;  // < 2^63 + 2^34: no overflow
+  const std::optional<std::uint32_t> isize =
+      nifti_is_gzfile(file.c_str()) ? gzip_isize(file, size) : std::nullopt;
+  if (!isize) return needed <= size;  // znzlib reads a .gz name without gzip magic as it is
+  if (needed / kMaxDeflateRatio > size) return false;
+  return *isize >= needed || gzip_stream_has(file, needed);
+}
+
+/// The voxels (`data_bytes` from byte `offset` of `file`) must be there before nifti_image_load
+/// allocates room for them.
+void require_voxel_bytes(const std::string& file, std::int64_t offset, std::uint64_t data_bytes,
+                         const std::string& path) {
+  require(file_holds(file, offset, data_bytes),
+          "voxel data missing or truncated: the header describes " + std::to_string(data_bytes) +
+              " bytes of voxels from byte " + std::to_string(offset) + " of " +
+              (file == path ? std::string("the file") : "'" + file + "'") +
+              ", which does not hold that many",
+          path, kCorruptFileHint);
+}
+
+/// Checks of the fields both versions share, after they were copied into `raw`.
+void check_raw_header(RawHeader& raw, int bitpix, std::size_t header_size,
+                      const std::string& path) {
+  const std::int64_t ndim = raw.dim[0];
+  require(ndim >= 1 && ndim <= 7,
+          "dim[0] = " + std::to_string(ndim) + ": the number of dimensions must be 1 to 7", path,
+          kCompleteFileHint);
+  raw.voxels = 1;
+  std::string shape;
+  for (int d = 1; d <= ndim; ++d) {
+    const std::int64_t n = raw.dim[std::size_t(d)];
+    require(n >= 1, "dim[" + std::to_string(d) + "] = " + std::to_string(n) + " is not a size",
+            path, kCompleteFileHint);
+    shape += (d > 1 ? " x " : "") + std::to_string(n);
+    require(std::uint64_t(n) <= kMaxVoxels / raw.voxels,
+            "the image is larger than " + std::to_string(kMaxVoxels) + " voxels (dim " + shape +
+                (d < ndim ? " x ..." : "") + "): not read",
+            path, "crop or downsample it first");
+    raw.voxels *= std::uint64_t(n);
+  }
+  require(with_voxel_type(raw.datatype, [&](auto tag) { raw.bytes_per_voxel = sizeof tag; }),
+          std::string("unsupported voxel type ") + nifti_datatype_string(raw.datatype), path,
+          "use int8/16/32, uint8/16/32, float32 or float64");
+  require(std::size_t(bitpix) == 8 * raw.bytes_per_voxel,
+          "bitpix = " + std::to_string(bitpix) + " does not match the voxel type " +
+              nifti_datatype_string(raw.datatype) + " (" +
+              std::to_string(8 * raw.bytes_per_voxel) + " bits)",
+          path, kCompleteFileHint);
+  require(raw.vox_offset >= 0, "vox_offset = " + std::to_string(raw.vox_offset) + " is negative",
+          path, kCompleteFileHint);
+  require(!raw.single_file || std::uint64_t(raw.vox_offset) >= header_size,
+          "vox_offset = " + std::to_string(raw.vox_offset) + " lies inside the " +
+              std::to_string(header_size) + "-byte header",
+          path, kCompleteFileHint);
+}
+
+template <class Header>
+void copy_fields(const Header& h, RawHeader& raw) {
+  raw.single_file = NIFTI_ONEFILE(h);
+  for (std::size_t d = 0; d < 8; ++d) {
+    raw.dim[d] = h.dim[d];
+    raw.pixdim[d] = h.pixdim[d];
+  }
+  raw.datatype = h.datatype;
+}
+
+/// Reads and checks the header of `file` (the header nifti_clib will read for `path`, named in
+/// the errors): NIfTI-1 (sizeof_hdr 348) or NIfTI-2 (540), either byte order, gzip or not.
+RawHeader read_raw_header(const std::string& file, const std::string& path) {
+  std::array<char, kNifti2HeaderSize> bytes{};
+  znzFile in = znzopen(file.c_str(), "rb", nifti_is_gzfile(file.c_str()));
+  require(!znz_isnull(in), "cannot open file", path, "check its permissions");
+  const std::optional<std::size_t> read = znz_read_bytes(bytes.data(), bytes.size(), in);
+  znzclose(in);
+  require(read.has_value(), std::string(kNotNifti) + ": its gzip stream is corrupt", path,
+          kCompleteFileHint);
+  const std::size_t got = *read;
+  const auto cut_short = [&](std::size_t size) {
+    return std::string(kNotNifti) + ": the header is cut short (" + std::to_string(got) + " of " +
+           std::to_string(size) + " bytes)";
+  };
+  require(got >= kNifti1HeaderSize, cut_short(kNifti1HeaderSize), path, kCompleteFileHint);
+
+  std::uint32_t sizeof_hdr = 0;
+  std::memcpy(&sizeof_hdr, bytes.data(), sizeof sizeof_hdr);
+  RawHeader raw;
+  raw.version = version_of_size(sizeof_hdr);
+  const bool swapped = raw.version == 0;  // other byte order, if it is NIfTI at all
+  if (swapped) raw.version = version_of_size(byte_swapped(sizeof_hdr));
+  require(raw.version != 0,
+          std::string(kNotNifti) + ": sizeof_hdr is " + std::to_string(sizeof_hdr) +
+              ", neither 348 (NIfTI-1) nor 540 (NIfTI-2) in either byte order",
+          path, kCompleteFileHint);
+
+  if (raw.version == 1) {
+    nifti_1_header h;
+    std::memcpy(&h, bytes.data(), sizeof h);
+    require(NIFTI_VERSION(h) != 0, "ANALYZE 7.5 file: it has no defined orientation", path,
+            "convert it to NIfTI");
+    require(NIFTI_VERSION(h) == 1,
+            std::string(kNotNifti) + ": NIfTI-1 header size with the magic of another version",
+            path, kCompleteFileHint);
+    if (swapped) swap_nifti_header(&h, 1);
+    copy_fields(h, raw);
+    // nifti_clib converts the float to int: only whole numbers in int range are offsets.
+    const float offset = h.vox_offset;
+    require(std::isfinite(offset) && offset >= 0.0f && offset < 2147483648.0f &&
+                offset == std::floor(offset),
+            "vox_offset = " + std::to_string(offset) + " is not a byte offset", path,
+            kCompleteFileHint);
+    raw.vox_offset = std::int64_t(offset);
+    check_raw_header(raw, h.bitpix, kNifti1HeaderSize, path);
+  } else {
+    require(got >= kNifti2HeaderSize, cut_short(kNifti2HeaderSize), path, kCompleteFileHint);
+    nifti_2_header h;
+    std::memcpy(&h, bytes.data(), sizeof h);
+    require(NIFTI_VERSION(h) == 2,
+            std::string(kNotNifti) + ": NIfTI-2 header size without the NIfTI-2 magic", path,
+            kCompleteFileHint);
+    if (swapped) swap_nifti_header(&h, 2);
+    copy_fields(h, raw);
+    raw.vox_offset = h.vox_offset;
+    check_raw_header(raw, h.bitpix, kNifti2HeaderSize, path);
+  }
+  return raw;
+}
+
 // ---- reading ---------------------------------------------------------------------------------
 
-NiftiPtr open_header(const std::string& path) {
+/// A header that passed read_raw_header, and nifti_clib's image of it (voxels not loaded).
+struct OpenedNifti {
+  RawHeader raw;
+  NiftiPtr nim;
+};
+
+OpenedNifti open_header(const std::string& path) {
   quiet_nifti_clib();
   std::error_code ec;
   require(std::filesystem::exists(path, ec), "file not found", path);
   require(std::filesystem::is_regular_file(path, ec), "not a regular file", path);
-  NiftiPtr nim(nifti_image_read(path.c_str(), /*read_data=*/0));
-  require(nim != nullptr, "not a readable NIfTI file (bad or truncated header)", path,
-          "check that the file is a complete .nii or .nii.gz file");
-  require(nim->nifti_type != NIFTI_FTYPE_ANALYZE, "ANALYZE 7.5 file: it has no defined orientation",
-          path, "convert it to NIfTI");
-  require(with_voxel_type(nim->datatype, [](auto) {}),
-          std::string("unsupported voxel type ") + nifti_datatype_string(nim->datatype), path,
-          "use int8/16/32, uint8/16/32, float32 or float64");
-  return nim;
+  // The file nifti_image_read will take the header from: `path` itself for a .nii or .nii.gz.
+  const std::unique_ptr<char, void (*)(void*)> header_file(nifti_findhdrname(path.c_str()),
+                                                           std::free);
+  require(header_file != nullptr, std::string(kNotNifti) + ": no NIfTI file name", path,
+          "NIfTI files are named .nii or .nii.gz");
+  const std::string header_path = header_file.get();
+  OpenedNifti file{read_raw_header(header_path, path), nullptr};
+  const RawHeader& raw = file.raw;
+  const std::uint64_t data_bytes = raw.voxels * raw.bytes_per_voxel;
+  // Before nifti_image_read: it reads header extensions up to vox_offset.
+  if (raw.single_file) require_voxel_bytes(header_path, raw.vox_offset, data_bytes, path);
+
+  file.nim.reset(nifti_image_read(path.c_str(), /*read_data=*/0));
+  require(file.nim != nullptr, std::string(kNotNifti) + " (bad or truncated header)", path,
+          kCompleteFileHint);
+  const nifti_image& nim = *file.nim;
+  require(nim.ndim == raw.dim[0] && std::uint64_t(nim.nvox) == raw.voxels &&
+              nim.datatype == raw.datatype && std::size_t(nim.nbyper) == raw.bytes_per_voxel &&
+              nim.iname != nullptr,
+          "nifti_clib read the header differently from our checks", path);
+  // Where nifti_image_load will read the voxels; checked above for a one-file header.
+  const bool checked = raw.single_file && header_path == nim.iname &&
+                       nim.iname_offset == raw.vox_offset;
+  if (!checked) require_voxel_bytes(nim.iname, nim.iname_offset, data_bytes, path);
+  return file;
 }
 
 /// Loads the voxels after the header has been accepted; a short read is a truncated file.
 void load_voxels(nifti_image& nim, const std::string& path) {
   require(nifti_image_load(&nim) >= 0 && nim.data != nullptr, "voxel data missing or truncated",
-          path, "the file is incomplete or corrupt; write or download it again");
+          path, kCorruptFileHint);
 }
 
 /// dim[5..7] must be 1 except as listed; dim[4] (time) must be 1.
@@ -154,41 +400,26 @@ double metres_per_unit(const nifti_image& nim, const std::string& path) {
   }
 }
 
-/// pixdim[1..3] as stored: nifti_image's copy has zeros already replaced by 1.
-std::array<double, 3> stored_pixdim(const std::string& path) {
-  int version = 0;
-  const std::unique_ptr<void, void (*)(void*)> header(
-      nifti_read_header(path.c_str(), &version, /*check=*/0), std::free);
-  require(header != nullptr && (version == 1 || version == 2), "cannot read the NIfTI header",
-          path);
-  const auto pixdim = [&](auto* h) {
-    if (h->sizeof_hdr != int(sizeof *h)) swap_nifti_header(h, version);  // other byte order
-    return std::array<double, 3>{h->pixdim[1], h->pixdim[2], h->pixdim[3]};
-  };
-  return version == 1 ? pixdim(static_cast<nifti_1_header*>(header.get()))
-                      : pixdim(static_cast<nifti_2_header*>(header.get()));
-}
-
-/// The qform and the bare-pixdim fallback take the spacing from pixdim.
-void check_pixdim(const std::string& path) {
-  const std::array<double, 3> pixdim = stored_pixdim(path);
-  for (std::size_t d = 0; d < 3; ++d)
-    require(std::isfinite(pixdim[d]) && pixdim[d] > 0.0,
-            "voxel spacing pixdim[" + std::to_string(d + 1) + "] = " + std::to_string(pixdim[d]) +
+/// The qform and the bare-pixdim fallback take the spacing from pixdim, as stored in the file.
+void check_pixdim(const RawHeader& raw, const std::string& path) {
+  for (std::size_t d = 1; d <= 3; ++d)
+    require(std::isfinite(raw.pixdim[d]) && raw.pixdim[d] > 0.0,
+            "voxel spacing pixdim[" + std::to_string(d) + "] = " + std::to_string(raw.pixdim[d]) +
                 " is not positive",
             path);
 }
 
 /// Voxel index -> file world (RAS, file unit): sform, else qform, else diag(pixdim).
-Eigen::Matrix4d file_affine(const nifti_image& nim, const std::string& path) {
+Eigen::Matrix4d file_affine(const nifti_image& nim, const RawHeader& raw,
+                            const std::string& path) {
   if (nim.sform_code > 0) return to_eigen(nim.sto_xyz);
-  check_pixdim(path);
+  check_pixdim(raw, path);
   if (nim.qform_code > 0) return to_eigen(nim.qto_xyz);
   return Eigen::Vector4d(nim.pixdim[1], nim.pixdim[2], nim.pixdim[3], 1.0).asDiagonal();
 }
 
 /// Dims and the LPS-metre affine; values left empty.
-ImageVolume read_grid(const nifti_image& nim, const std::string& path) {
+ImageVolume read_grid(const nifti_image& nim, const RawHeader& raw, const std::string& path) {
   ImageVolume grid;
   for (int d = 0; d < 3; ++d) {
     const std::int64_t n = d < nim.dim[0] ? nim.dim[d + 1] : 1;
@@ -198,7 +429,7 @@ ImageVolume read_grid(const nifti_image& nim, const std::string& path) {
         path);
     grid.dims[std::size_t(d)] = int(n);
   }
-  grid.affine_lps_m = ras_lps_flip() * file_affine(nim, path);
+  grid.affine_lps_m = ras_lps_flip() * file_affine(nim, raw, path);
   grid.affine_lps_m.topRows<3>() *= metres_per_unit(nim, path);
   check_affine(grid.affine_lps_m, path);
   return grid;
@@ -225,11 +456,23 @@ struct LoadedNifti {
 };
 
 LoadedNifti load(const std::string& path, int components) {
-  LoadedNifti file{open_header(path), {}};
+  OpenedNifti opened = open_header(path);
+  LoadedNifti file{std::move(opened.nim), {}};
   check_extra_dims(*file.nim, components, path);
-  file.grid = read_grid(*file.nim, path);
+  file.grid = read_grid(*file.nim, opened.raw, path);
   load_voxels(*file.nim, path);
   return file;
+}
+
+/// Runs a reader; running out of memory (an image within the limits, on a small machine) is a
+/// vb::Error naming the file like any other failure.
+template <class Read>
+auto guard_memory(const std::string& path, Read&& read) {
+  try {
+    return read();
+  } catch (const std::bad_alloc&) {
+    throw Error("not enough memory to read the image", path, "free memory or use a smaller image");
+  }
 }
 
 // ---- writing ---------------------------------------------------------------------------------
@@ -338,10 +581,12 @@ int datatype_of(NiftiType type) {
 // ---- public API --------------------------------------------------------------------------------
 
 ImageVolume read_nifti(const std::string& path) {
-  LoadedNifti file = load(path, 1);
-  file.grid.values = scaled_values(*file.nim);
-  file.grid.modality = file.nim->intent_code == NIFTI_INTENT_LABEL ? "LABEL" : "";
-  return std::move(file.grid);
+  return guard_memory(path, [&] {
+    LoadedNifti file = load(path, 1);
+    file.grid.values = scaled_values(*file.nim);
+    file.grid.modality = file.nim->intent_code == NIFTI_INTENT_LABEL ? "LABEL" : "";
+    return std::move(file.grid);
+  });
 }
 
 void write_nifti(const std::string& path, const ImageVolume& image, NiftiType type) {
@@ -389,24 +634,26 @@ void write_nifti_displacement(const std::string& path, const ImageVolume& grid,
 
 ImageVolume read_nifti_displacement(const std::string& path,
                                     std::vector<float>& displacement_lps_m) {
-  LoadedNifti file = load(path, int(kVectorComponents));
-  const int intent = file.nim->intent_code;
-  require(intent == NIFTI_INTENT_DISPVECT || intent == NIFTI_INTENT_VECTOR,
-          "intent code " + std::to_string(intent) + " is not a displacement field", path,
-          "expected 1006 (NIFTI_INTENT_DISPVECT) or 1007 (NIFTI_INTENT_VECTOR)");
-  // DISPVECT components are RAS (ITK >= 5.4, Slicer); VECTOR ones are ITK's LPS, unconverted.
-  const double unit = metres_per_unit(*file.nim, path);
-  std::array<double, 3> factor{unit, unit, unit};
-  if (intent == NIFTI_INTENT_DISPVECT)
-    for (std::size_t c = 0; c < kVectorComponents; ++c) factor[c] *= kLpsRasSign[c];
+  return guard_memory(path, [&] {
+    LoadedNifti file = load(path, int(kVectorComponents));
+    const int intent = file.nim->intent_code;
+    require(intent == NIFTI_INTENT_DISPVECT || intent == NIFTI_INTENT_VECTOR,
+            "intent code " + std::to_string(intent) + " is not a displacement field", path,
+            "expected 1006 (NIFTI_INTENT_DISPVECT) or 1007 (NIFTI_INTENT_VECTOR)");
+    // DISPVECT components are RAS (ITK >= 5.4, Slicer); VECTOR ones are ITK's LPS, unconverted.
+    const double unit = metres_per_unit(*file.nim, path);
+    std::array<double, 3> factor{unit, unit, unit};
+    if (intent == NIFTI_INTENT_DISPVECT)
+      for (std::size_t c = 0; c < kVectorComponents; ++c) factor[c] *= kLpsRasSign[c];
 
-  const std::vector<float> stored = scaled_values(*file.nim);
-  const std::size_t n = file.grid.voxel_count();
-  displacement_lps_m.resize(kVectorComponents * n);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t c = 0; c < kVectorComponents; ++c)
-      displacement_lps_m[kVectorComponents * i + c] = float(factor[c] * stored[c * n + i]);
-  return std::move(file.grid);
+    const std::vector<float> stored = scaled_values(*file.nim);
+    const std::size_t n = file.grid.voxel_count();
+    displacement_lps_m.resize(kVectorComponents * n);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t c = 0; c < kVectorComponents; ++c)
+        displacement_lps_m[kVectorComponents * i + c] = float(factor[c] * stored[c * n + i]);
+    return std::move(file.grid);
+  });
 }
 
 }  // namespace vb

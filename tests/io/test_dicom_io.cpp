@@ -2,13 +2,16 @@
 // python3-pydicom and its sample files) and DCMTK's command-line tools (dcmdump, dcmodify,
 // dcmcjpeg, dcmcjpls, dcmcrle). Tests that need a missing tool or file skip with the reason.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -530,6 +533,131 @@ TEST(DicomWrite, WideRangeGetsAFittedSlope) {
   const double step = (90000.0 + 60000.0) / 65535.0;
   for (std::size_t n = 0; n < v.values.size(); ++n)
     ASSERT_NEAR(back.values[n], v.values[n], 0.5 * step + 1e-3) << "voxel " << n;
+}
+
+// ---- fuzzing regressions (tests/fuzz/regressions/: slice files as the fuzzer wrote them) -----
+
+const fs::path kRegressions = fs::path(VOXBREAST_SOURCE_DIR) / "tests" / "fuzz" / "regressions";
+
+std::string regression_bytes(const std::string& name) {
+  std::ifstream in(kRegressions / name, std::ios::binary);
+  EXPECT_TRUE(in) << kRegressions / name;
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// `bytes` with the value of the explicit VR little endian US attribute (group,element) replaced.
+std::string with_us(std::string bytes, unsigned group, unsigned element, unsigned value) {
+  const std::string key = {char(group & 0xff), char(group >> 8), char(element & 0xff),
+                           char(element >> 8),  'U',              'S',
+                           2,                   0};
+  const std::size_t at = bytes.find(key);
+  EXPECT_NE(at, std::string::npos) << "no US attribute " << group << "," << element;
+  if (at == std::string::npos) return bytes;
+  bytes[at + 8] = char(value & 0xff);
+  bytes[at + 9] = char(value >> 8);
+  return bytes;
+}
+
+std::uint64_t peak_rss_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return std::uint64_t(usage.ru_maxrss) * 1024;  // Linux: kilobytes
+}
+
+/// Reads a folder holding one slice file with these bytes; the read must fail at once (2 s) and
+/// without raising this process's peak resident memory by more than 64 MiB. Its message.
+std::string cheap_failure(const std::string& bytes, fs::path& slice) {
+  static std::atomic<int> counter{0};
+  static TempDir tmp;
+  const fs::path dir = tmp / ("case" + std::to_string(counter++));
+  fs::create_directories(dir);
+  slice = dir / "slice.dcm";
+  std::ofstream(slice, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+  const auto start = std::chrono::steady_clock::now();
+  const std::uint64_t peak = peak_rss_bytes();
+  const std::string message = error_of([&] { read_dicom_series(dir.string()); });
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+  EXPECT_LT(peak_rss_bytes() - peak, std::uint64_t(64) << 20);
+  return message;
+}
+
+/// Rows = Columns = 65535 with 12 bytes of pixel data made read_dicom_series allocate 17 GB for
+/// the volume (std::bad_alloc escaped). Now the voxel count is capped and each slice's pixel data
+/// length is checked against Rows × Columns before the volume is allocated.
+TEST(DicomRead, FuzzRegressionHugeRowsColumns) {
+  const std::string bytes = regression_bytes("dicom_rows_columns_65535.dcm");
+  fs::path slice;
+  std::string message = cheap_failure(bytes, slice);
+  EXPECT_NE(message.find(slice.parent_path().string() + ": the series has 4294836225 voxels"),
+            std::string::npos)
+      << message;
+
+  const std::string under_cap = with_us(with_us(bytes, 0x0028, 0x0010, 30000), 0x0028, 0x0011,
+                                        30000);  // 9e8 voxels: only the length check stops it
+  message = cheap_failure(under_cap, slice);
+  EXPECT_NE(message.find(slice.string() + ": pixel data too short: 12 bytes for 30000 x 30000"),
+            std::string::npos)
+      << message;
+}
+
+/// A JPEG lossless slice claiming 65 samples per pixel and 32775 rows was decoded by DCMTK into a
+/// 660 MB buffer, copied again, and read as a 155 x 32775 volume. Now the pixel attributes are
+/// checked before decoding, and so is the size of the compressed frame against Rows × Columns.
+TEST(DicomRead, FuzzRegressionCompressedSliceCheckedBeforeDecoding) {
+  const std::string bytes = regression_bytes("dicom_jpeg_65_samples.dcm");
+  fs::path slice;
+  std::string message = cheap_failure(bytes, slice);
+  EXPECT_NE(message.find(slice.string() + ": only greyscale images (SamplesPerPixel 1)"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("SamplesPerPixel 65"), std::string::npos) << message;
+
+  // One sample: DCMTK would decode the 2 x 3 frame into a 155 x 32775 buffer without complaint.
+  const std::string one_sample = with_us(bytes, 0x0028, 0x0002, 1);
+  message = cheap_failure(one_sample, slice);
+  EXPECT_NE(message.find(slice.string() + ": the compressed frame is 2 x 3 pixels"),
+            std::string::npos)
+      << message;
+
+  // 65535 x 32768 pixels from 1.4 kB of JPEG: refused before DCMTK allocates 4 GiB for them.
+  const std::string huge = with_us(with_us(one_sample, 0x0028, 0x0010, 32768), 0x0028, 0x0011,
+                                   65535);
+  message = cheap_failure(huge, slice);
+  EXPECT_NE(message.find(slice.string() + ": compressed pixel data in a file of"),
+            std::string::npos)
+      << message;
+
+  std::string colour = one_sample;
+  const std::size_t photometric = colour.find("MONOCHROME2 ");
+  ASSERT_NE(photometric, std::string::npos);
+  colour.replace(photometric, 12, "YBR_FULL_422");
+  message = cheap_failure(colour, slice);
+  EXPECT_NE(message.find(slice.string() + ": only greyscale images (PhotometricInterpretation"),
+            std::string::npos)
+      << message;
+
+  message = cheap_failure(with_us(one_sample, 0x0028, 0x0100, 12), slice);
+  EXPECT_NE(message.find(slice.string() + ": unsupported pixel layout (BitsAllocated 12"),
+            std::string::npos)
+      << message;
+}
+
+/// DCMTK reads a deflated dataset through zlib and allocates each value as long as its length
+/// field says before it finds the stream too short (4 GiB for these 0.9 kB files, hand-made from
+/// the fuzzing seed). The deflated dataset is now walked first; a length that the data does not
+/// back is an error naming the file, found both when the folder is scanned and when it is read.
+TEST(DicomRead, DeflatedDatasetLengthsAreCheckedBeforeDcmtkReadsThem) {
+  for (const std::string name :
+       {"dicom_deflated_pixel_length_4gib.dcm", "dicom_deflated_private_length_4gib.dcm"}) {
+    fs::path slice;
+    const std::string message = cheap_failure(regression_bytes(name), slice);
+    EXPECT_NE(message.find(slice.string() + ": cannot parse DICOM file: the deflated dataset is "
+                                            "corrupt or truncated"),
+              std::string::npos)
+        << name << ": " << message;
+    const std::string listed = error_of([&] { list_dicom_series(slice.parent_path().string()); });
+    EXPECT_NE(listed.find("the deflated dataset is corrupt"), std::string::npos) << listed;
+  }
 }
 
 TEST(DicomRead, FolderErrors) {

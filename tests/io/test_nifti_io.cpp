@@ -2,10 +2,12 @@
 // displacement-field convention on disk, and broken files that must throw (not crash).
 #include <gtest/gtest.h>
 #include <nifti/nifti2_io.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -14,12 +16,14 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <random>
 #include <sstream>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "engine/error.hpp"
@@ -515,6 +519,188 @@ TEST_F(NiftiIo, WriteErrorsLeaveNoFile) {
       [&] { write_nifti(nowhere, oblique_volume(NiftiType::Float32), NiftiType::Float32); },
       nowhere, "cannot create");
   EXPECT_TRUE(fs::is_empty(dir_));
+}
+
+// ---- fuzzing regressions (tests/fuzz/regressions/, the fuzzer's flag byte removed) --------------
+
+const fs::path kRegressions = fs::path(VOXBREAST_SOURCE_DIR) / "tests" / "fuzz" / "regressions";
+
+std::vector<char> file_bytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  EXPECT_TRUE(in) << file;
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_bytes(const std::string& file, const std::vector<char>& bytes) {
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), std::streamsize(bytes.size()));
+  ASSERT_TRUE(out) << file;
+}
+
+/// `bytes` as one gzip member, written through znzlib like any .nii.gz (`scratch` is reused).
+std::vector<char> gzipped(const std::vector<char>& bytes, const std::string& scratch) {
+  znzFile out = znzopen(scratch.c_str(), "wb", 1);
+  EXPECT_FALSE(znz_isnull(out)) << scratch;
+  if (znz_isnull(out)) return {};
+  EXPECT_EQ(znzwrite(bytes.data(), 1, bytes.size(), out), bytes.size());
+  EXPECT_EQ(znzclose(out), 0);
+  std::vector<char> packed = file_bytes(scratch);
+  fs::remove(scratch);
+  return packed;
+}
+
+std::uint64_t peak_rss_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return std::uint64_t(usage.ru_maxrss) * 1024;  // Linux: kilobytes
+}
+
+/// For a read that must fail at once: bounds the time it takes and how much it raises this
+/// process's peak resident memory.
+class CheapFailure {
+ public:
+  CheapFailure() : start_(std::chrono::steady_clock::now()), peak_(peak_rss_bytes()) {}
+  ~CheapFailure() {
+    EXPECT_LT(std::chrono::steady_clock::now() - start_, std::chrono::seconds(2));
+    EXPECT_LT(peak_rss_bytes() - peak_, std::uint64_t(64) << 20);
+  }
+  CheapFailure(const CheapFailure&) = delete;
+  CheapFailure& operator=(const CheapFailure&) = delete;
+
+ private:
+  std::chrono::steady_clock::time_point start_;
+  std::uint64_t peak_;
+};
+
+/// nifti_clib 3.0.1 copied dim[0] + 1 entries of a NIfTI-2 dim[] into an 8-entry array (stack
+/// corruption) and accepted dim[0] = 9: our header check refuses them first, .nii or .nii.gz.
+TEST_F(NiftiIo, FuzzRegressionNifti2DimZeroOutOfRange) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"nifti2_dim0_stack_overflow.nii", "dim[0] = 2319282339843"},
+      {"nifti2_dim0_768_stack_corruption.nii", "dim[0] = 768"},
+      {"nifti2_dim0_huge_minimal.nii", "dim[0] = 1099511627776"},
+      {"nifti2_dim0_768_minimal.nii", "dim[0] = 768"},
+      {"nifti2_dim0_9.nii", "dim[0] = 9"}};
+  for (const auto& [name, text] : cases) {
+    const std::vector<char> bytes = file_bytes(kRegressions / name);
+    const std::string plain = path(name), gzip = path(name + ".gz");
+    write_bytes(plain, bytes);
+    write_bytes(gzip, gzipped(bytes, path("scratch.gz")));
+    for (const std::string& file : {plain, gzip}) {
+      CheapFailure cheap;
+      expect_error([&] { read_nifti(file); }, file, text);
+      std::vector<float> u;
+      expect_error([&] { read_nifti_displacement(file, u); }, file, text);
+    }
+  }
+}
+
+/// Big-endian files read like little-endian ones, and their header is checked in their order.
+TEST_F(NiftiIo, ByteSwappedHeadersAreCheckedInTheirOwnOrder) {
+  const auto swapped_file = [&](const std::string& name, bool nifti2, std::int64_t dim0) {
+    RawSpec spec;
+    spec.nifti_type = nifti2 ? NIFTI_FTYPE_NIFTI2_1 : NIFTI_FTYPE_NIFTI1_1;
+    write_raw(path("native.nii"), spec);
+    std::vector<char> bytes = file_bytes(path("native.nii"));
+    const std::size_t header_size = nifti2 ? sizeof(nifti_2_header) : sizeof(nifti_1_header);
+    if (nifti2) {
+      nifti_2_header h;
+      std::memcpy(&h, bytes.data(), sizeof h);
+      h.dim[0] = dim0;
+      swap_nifti_header(&h, 2);
+      std::memcpy(bytes.data(), &h, sizeof h);
+    } else {
+      nifti_1_header h;
+      std::memcpy(&h, bytes.data(), sizeof h);
+      h.dim[0] = std::int16_t(dim0);
+      swap_nifti_header(&h, 1);
+      std::memcpy(bytes.data(), &h, sizeof h);
+    }
+    EXPECT_EQ(bytes[0], 0) << "sizeof_hdr not swapped";
+    for (std::size_t at = header_size + 4; at + 1 < bytes.size(); at += 2)  // int16 voxels
+      std::swap(bytes[at], bytes[at + 1]);
+    const bool gzip = name.size() > 3 && name.compare(name.size() - 3, 3, ".gz") == 0;
+    write_bytes(path(name), gzip ? gzipped(bytes, path("scratch.gz")) : bytes);
+    return path(name);
+  };
+  for (const bool nifti2 : {false, true}) {
+    for (const std::string name : {"swapped.nii", "swapped.nii.gz"}) {
+      SCOPED_TRACE(std::string(nifti2 ? "NIfTI-2 " : "NIfTI-1 ") + name);
+      const ImageVolume image = read_nifti(swapped_file(name, nifti2, 3));
+      EXPECT_EQ(image.dims, (std::array<int, 3>{3, 4, 2}));
+      ASSERT_EQ(image.values.size(), 24u);
+      for (std::size_t v = 0; v < image.values.size(); ++v)
+        EXPECT_EQ(image.values[v], float(raw_value(v))) << v;
+      const std::string bad = swapped_file("bad_" + name, nifti2, 9);
+      CheapFailure cheap;
+      expect_error([&] { read_nifti(bad); }, bad, "dim[0] = 9");
+    }
+  }
+}
+
+/// A 360-byte header claiming 2306 x 254 x 6914 uint8 voxels made nifti_image_load allocate 4 GB.
+/// Now the voxel count is capped, and the voxels a header claims must fit in the file: its size
+/// for .nii, the deflate ratio and the gzip trailer for .nii.gz, before anything is allocated.
+TEST_F(NiftiIo, FuzzRegressionTinyFileClaimingHugeImage) {
+  const std::vector<char> bytes = file_bytes(kRegressions / "nifti1_4gb_claim.nii");
+  ASSERT_EQ(bytes.size(), 360u);
+  const std::string original = path("claim.nii");
+  write_bytes(original, bytes);
+  {
+    CheapFailure cheap;
+    expect_error([&] { read_nifti(original); }, original, "larger than 2147483648 voxels");
+  }
+
+  // Under the cap (2306 x 254 x 1000 = 585724000 bytes) and with a sane vox_offset: the size.
+  nifti_1_header h;
+  std::memcpy(&h, bytes.data(), sizeof h);
+  h.dim[3] = 1000;
+  h.vox_offset = 352.0f;
+  std::vector<char> smaller = bytes;
+  std::memcpy(smaller.data(), &h, sizeof h);
+  const std::vector<char> packed = gzipped(smaller, path("scratch.gz"));
+  // A gzip trailer claiming 4 GiB - 1 uncompressed bytes; 1 MiB of zeros after the header, so
+  // that reading the header does not reach the trailer (zlib checks it at the end of the stream).
+  std::vector<char> padded = smaller;
+  padded.resize(padded.size() + (std::size_t(1) << 20), 0);
+  std::vector<char> forged = gzipped(padded, path("scratch.gz"));
+  std::fill(forged.end() - 4, forged.end(), char(0xff));
+  const std::vector<std::pair<std::string, const std::vector<char>*>> files = {
+      {"smaller.nii", &smaller}, {"smaller.nii.gz", &packed}, {"forged.nii.gz", &forged}};
+  for (const auto& [name, content] : files) {
+    write_bytes(path(name), *content);
+    CheapFailure cheap;
+    expect_error([&] { read_nifti(path(name)); }, path(name),
+                 "voxel data missing or truncated: the header describes 585724000 bytes");
+    std::vector<float> u;
+    expect_error([&] { read_nifti_displacement(path(name), u); }, path(name), "585724000 bytes");
+  }
+}
+
+/// The gzip trailer counts only the last member of a multi-member file: the check then counts the
+/// decompressed stream instead, so such a file still reads, and a short one is still refused.
+TEST_F(NiftiIo, MultiMemberGzipIsMeasuredByItsStream) {
+  ImageVolume image = oblique_grid();
+  image.dims = {40, 30, 20};
+  image.values.resize(image.voxel_count());
+  for (std::size_t v = 0; v < image.values.size(); ++v) image.values[v] = float(v % 997);
+  write_nifti(path("plain.nii"), image, NiftiType::Float32);
+  const std::vector<char> bytes = file_bytes(path("plain.nii"));
+  const auto two_members = [&](std::size_t size) {
+    const std::size_t half = size / 2;
+    std::vector<char> out = gzipped({bytes.begin(), bytes.begin() + long(half)}, path("a.gz"));
+    const std::vector<char> second =
+        gzipped({bytes.begin() + long(half), bytes.begin() + long(size)}, path("b.gz"));
+    out.insert(out.end(), second.begin(), second.end());
+    return out;
+  };
+  write_bytes(path("multi.nii.gz"), two_members(bytes.size()));
+  const ImageVolume read = read_nifti(path("multi.nii.gz"));
+  EXPECT_EQ(read.dims, image.dims);
+  EXPECT_EQ(read.values, image.values);
+
+  write_bytes(path("short.nii.gz"), two_members(bytes.size() - 100));
+  expect_error([&] { read_nifti(path("short.nii.gz")); }, path("short.nii.gz"), "truncated");
 }
 
 // ---- external check through nibabel ------------------------------------------------------------
