@@ -22,6 +22,7 @@ struct BenchOptions {
   std::string out, device;
   bool quick = false;
   std::vector<int> sizes;  ///< block edge lengths in elements
+  std::vector<std::string> laws{"linear"};  ///< extra laws timed with Heun + float
 };
 
 struct BenchCase {
@@ -29,6 +30,7 @@ struct BenchCase {
   int edge = 0;
   Integrator integrator = Integrator::Heun;
   Precision precision = Precision::Float;
+  std::string law = "linear";
 };
 
 /// A cube of `edge`³ adipose elements, base held, under gravity: the standard linear block.
@@ -45,6 +47,12 @@ Scene block_scene(const BenchCase& c) {
   MaterialSpec m;
   m.name = "adipose";
   m.youngs_modulus_pa = 3000;
+  m.law = c.law;
+  if (c.law == "ogden") {  // a two-term Ogden tissue with μ₀ = 1.8 kPa
+    m.ogden_mu_pa = {1200, -300};
+    m.ogden_alpha = {4, -2};
+  }
+  m.poisson_ratio = 0.45;
   s.materials["adipose"] = m;
   s.solver.integrator = c.integrator;
   s.solver.precision = c.precision;
@@ -99,10 +107,14 @@ double copy_bandwidth(const ClContext& cl, std::size_t bytes) {
 
 /// Bytes a Heun step must move per element, counting each element's own state once per stage
 /// (neighbour reads are served from cache): stage 1 reads u, v, E, cell, grid and writes ũ, ṽ;
-/// stage 2 reads u, v, ũ, ṽ, E, cell, grid and writes u, v.
-double heun_bytes_per_element(std::size_t real_size) {
+/// stage 2 reads u, v, ũ, ṽ, E, cell, grid and writes u, v. Hyperelastic tissues add, per
+/// stage, the stress pass (reads u, cell, grid, tissue; writes F and Q: 6 vectors) and the
+/// gather's read of the element's own F and Q and tissue.
+double heun_bytes_per_element(std::size_t real_size, bool hyperelastic) {
   const double vec = 4.0 * double(real_size), scalar = double(real_size), idx = 4.0;
-  return (2 * vec + scalar + 2 * idx + 2 * vec) + (4 * vec + scalar + 2 * idx + 2 * vec);
+  const double springs = (2 * vec + scalar + 2 * idx + 2 * vec) + (4 * vec + scalar + 2 * idx + 2 * vec);
+  const double stress_pass = (vec + 2 * idx + 1 + 6 * vec) + (6 * vec + 1);
+  return springs + (hyperelastic ? 2 * stress_pass : 0.0);
 }
 
 int run_bench(const BenchOptions& o) {
@@ -121,6 +133,8 @@ int run_bench(const BenchOptions& o) {
       cases.push_back({"block", edge, Integrator::SymplecticEuler, Precision::Float});
       if (cl.info.fp64) cases.push_back({"block", edge, Integrator::Heun, Precision::Double});
     }
+    for (const std::string& law : o.laws)
+      if (law != "linear") cases.push_back({"block", edge, Integrator::Heun, Precision::Float, law});
   }
   nlohmann::json rows = nlohmann::json::array();
   std::ostringstream csv;
@@ -135,17 +149,18 @@ int run_bench(const BenchOptions& o) {
     const std::size_t n = lattice.element_count();
     const std::size_t real_size = c.precision == Precision::Double ? 8 : 4;
     const bool heun = c.integrator == Integrator::Heun;
-    const double bytes = heun ? heun_bytes_per_element(real_size) : heun_bytes_per_element(real_size) / 2;
+    const bool hyper = c.law != "linear";
+    const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, hyper);
     const double effective = bytes * double(n) * sps;
     const char* integ = heun ? "heun" : "symplectic_euler";
     const char* prec = c.precision == Precision::Double ? "double" : "float";
-    std::printf("%-6s %9zu elements  linear  %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
-                c.name.c_str(), n, integ, prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
-    rows.push_back({{"model", c.name}, {"elements", n}, {"law", "linear"}, {"integrator", integ}, {"precision", prec},
+    std::printf("%-6s %9zu elements  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
+                c.name.c_str(), n, c.law.c_str(), integ, prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
+    rows.push_back({{"model", c.name}, {"elements", n}, {"law", c.law}, {"integrator", integ}, {"precision", prec},
                     {"steps_per_s", sps}, {"bytes_per_element_step", bytes}, {"effective_bandwidth_gb_s", effective / 1e9},
                     {"fraction_of_copy_bandwidth", effective / bandwidth},
                     {"device_bytes_per_element", double(sim.device_bytes()) / double(n)}});
-    csv << c.name << "," << n << ",linear," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
+    csv << c.name << "," << n << "," << c.law << "," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
         << "\n";
   }
@@ -167,6 +182,8 @@ Command add_bench(CLI::App& app) {
   sub->add_option("--device,-d", o->device, "OpenCL device: gpu, cpu, an index or a name");
   sub->add_flag("--quick", o->quick, "short timings, Heun + float only");
   sub->add_option("--sizes", o->sizes, "block edge lengths in elements (default 33 115)")->check(CLI::Range(2, 1000));
+  sub->add_option("--laws", o->laws, "material laws to time (linear, neo-hookean, mooney-rivlin, ogden; default linear)")
+      ->check(CLI::IsMember({"linear", "neo-hookean", "ogden"}));
   return {sub, [o] { return run_bench(*o); }};
 }
 

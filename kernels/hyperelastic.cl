@@ -2,8 +2,8 @@
 // element's deformation gradient by least squares over its existing neighbours,
 //   F = A·B⁻¹,  A = Σ Δx ΔXᵀ,  B = Σ ΔX ΔXᵀ  (ΔX = h·d rest offsets, Δx deformed),
 // the law's first Piola-Kirchhoff stress P(F), and Q = V·P·B⁻¹. The energy V·W(F_e) then puts
-// force Q_e·(h·d) on each neighbour and −Q_e·Σ h·d on the element itself (pass 2 gathers them in
-// lattice_force): total force and torque vanish and rigid motions give none.
+// force −Q_e·(h·d) on each neighbour at offset h·d and +Q_e·Σ h·d on the element itself (pass 2
+// gathers them in lattice_force): total force and torque vanish and rigid motions give none.
 //
 // Material table (global const real*, VB_MAT_STRIDE reals per tissue):
 //   0 law (0 linear springs, 1 neo-Hookean/Mooney-Rivlin by invariants, 2 Ogden by stretches)

@@ -58,8 +58,9 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
   const double h = lattice.spacing_m;
   const double extent = h * Eigen::Vector3d(lattice.dims[0], lattice.dims[1], lattice.dims[2]).norm();
   const double tol = scene.stop.equilibrium;
-  double travel_end = 0;  // equilibrium only counts once every indenter has stopped
-  for (const IndenterSpec& ind : scene.indenters) travel_end = std::max(travel_end, ind.travel_time_s);
+  double travel_end = 0;  // equilibrium only counts once every moving indenter has stopped
+  for (const IndenterSpec& ind : scene.indenters)
+    if (ind.velocity_m_s.squaredNorm() > 0) travel_end = std::max(travel_end, ind.travel_time_s);
   const std::int64_t check_every = std::max(1, scene.solver.check_every);
   const std::int64_t frames_every = scene.output.frames_every;
   std::int64_t max_steps = scene.stop.max_steps;
