@@ -17,17 +17,22 @@ case "${1:-}" in
     ldd "$build/apps/voxbreast" | awk '/=> \// {print $3}' | grep -vE '/(libc|libm|libdl|libpthread|librt|libresolv|ld-linux[^/]*)\.so' |
       while read -r lib; do cp -L "$lib" "$pkgs/lib/"; done
     (cd "$pkgs/deb" && apt-get download ocl-icd-libopencl1 clinfo >/dev/null)
+    cp "$(dpkg -L libdcmtk17 2>/dev/null | grep '/dicom.dic$' | head -1)" "$pkgs/lib/"  # DCMTK's dictionary
+    # One xz archive keeps the carried folder under the device tool's 64 MiB (libicudata is 30 MB).
+    tar -C "$pkgs" -cJf "$pkgs/bundle.tar.xz" bin lib && rm -rf "$pkgs/bin" "$pkgs/lib"
     du -sh "$pkgs"
     ;;
   run)
     shift
     tmp=$(mktemp -d)
+    tar -C "$tmp" -xJf "$pkgs/bundle.tar.xz"
     for deb in "$pkgs"/deb/*.deb; do dpkg -x "$deb" "$tmp/root"; done
     mkdir -p "$tmp/icd"
     echo "libnvidia-opencl.so.1" >"$tmp/icd/nvidia.icd"
     export OCL_ICD_VENDORS=$tmp/icd
-    export LD_LIBRARY_PATH=$tmp/root/usr/lib/x86_64-linux-gnu:$pkgs/lib:${LD_LIBRARY_PATH:-}
-    export PATH=$pkgs/bin:$tmp/root/usr/bin:$PATH
+    export LD_LIBRARY_PATH=$tmp/root/usr/lib/x86_64-linux-gnu:$tmp/lib:${LD_LIBRARY_PATH:-}
+    export PATH=$tmp/bin:$tmp/root/usr/bin:$PATH
+    export DCMDICTPATH=$tmp/lib/dicom.dic
     "$@"
     ;;
   *)
