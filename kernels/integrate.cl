@@ -23,36 +23,35 @@ inline void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_o
 #endif
 }
 
-kernel void euler_step(global const real4* u, global const real4* v, global real4* u_out,
-                       global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                       uint n) {
+// One explicit stage from (u, v): symplectic Euler updates v first and moves with the new v;
+// Heun's predictor (explicit Euler) moves with the old v. `symplectic` is a constant at each call.
+inline void explicit_stage(global const real4* u, global const real4* v, global real4* u_out,
+                           global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
+                           uint n, int symplectic) {
   const uint e = get_global_id(0);
   if (e >= n) return;
   real4 ui = u[e], vi = v[e];
   if (ui.w != 0) {
     const real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force);
-    vi += dt * a;
+    if (symplectic) vi += dt * a;
     ui += dt * xyz0(vi);
+    if (!symplectic) vi += dt * a;
     finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, indenters, t_project);
   }
   u_out[e] = ui;
   v_out[e] = vi;
 }
 
+kernel void euler_step(global const real4* u, global const real4* v, global real4* u_out,
+                       global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
+                       uint n) {
+  explicit_stage(u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1);
+}
+
 kernel void heun_predict(global const real4* u, global const real4* v, global real4* u_pred,
                          global real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
                          uint n) {
-  const uint e = get_global_id(0);
-  if (e >= n) return;
-  real4 ui = u[e], vi = v[e];
-  if (ui.w != 0) {
-    const real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force);
-    ui += dt * xyz0(vi);
-    vi += dt * a;
-    finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, indenters, t_project);
-  }
-  u_pred[e] = ui;
-  v_pred[e] = vi;
+  explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0);
 }
 
 kernel void heun_correct(global real4* u, global real4* v, global const real4* u_pred,

@@ -159,10 +159,4 @@ LabelVolume lattice_volume_from_image(const ModelSpec& model, const ImageVolume&
   return vol;
 }
 
-std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision, bool hyperelastic) {
-  const std::size_t real = precision == Precision::Double ? 8 : 4;
-  const std::size_t hyper = hyperelastic ? 2 * 3 * 4 * real + 1 : 0;  // F and Q rows, tissue id
-  return elements * (4 * 4 * real + real + 4 + hyper) + cells * 4;
-}
-
 }  // namespace vb

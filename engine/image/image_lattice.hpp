@@ -24,9 +24,4 @@ TissueMap classify_image(const ModelSpec& model, const ImageVolume& ct, const Im
 /// Nearest-neighbour: each lattice voxel takes the tissue of the CT voxel containing its centre.
 LabelVolume lattice_volume_from_image(const ModelSpec& model, const ImageVolume& ct, const TissueMap& map);
 
-/// Device bytes a model of `elements` elements in a padded grid of `cells` voxels needs
-/// (hyperelastic models also store F and Q per element).
-std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision,
-                                   bool hyperelastic = false);
-
 }  // namespace vb

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "engine/error.hpp"
-#include "engine/image/image_lattice.hpp"
 #include "engine/sim/kernel_tables.hpp"
 
 namespace vb {
@@ -40,6 +39,16 @@ void unpack4(const std::vector<T>& in, std::vector<double>& xyz) {
 }
 
 std::string mib(double bytes) { return std::to_string(static_cast<long long>(bytes / (1 << 20))) + " MiB"; }
+
+}  // namespace
+
+std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision, bool hyperelastic) {
+  const std::size_t real = precision == Precision::Double ? 8 : 4;
+  const std::size_t hyper = hyperelastic ? 2 * 3 * 4 * real + 1 : 0;  // F and Q rows, tissue id
+  return elements * (4 * 4 * real + real + 4 + hyper) + cells * 4;
+}
+
+namespace {
 
 /// Smallest downsample factor f whose model (about bytes/f³) fits the device.
 int fitting_downsample(std::size_t bytes, const DeviceInfo& device) {
@@ -77,7 +86,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   const std::size_t state_bytes = 4 * real_size_ * n_;
   device_bytes_ = estimated_device_bytes(n_, cells, precision_, el.hyperelastic);
   require(double(device_bytes_) < 0.9 * double(cl.info.global_memory_bytes) &&
-              std::max(state_bytes, cells * sizeof(cl_int)) <= cl.info.max_allocation_bytes,
+              std::max((el.hyperelastic ? 3 : 1) * state_bytes, cells * sizeof(cl_int)) <= cl.info.max_allocation_bytes,
           "the model needs " + mib(double(device_bytes_)) + " of device memory but '" + cl.info.name +
               "' has " + mib(double(cl.info.global_memory_bytes)) + " (largest buffer " +
               mib(double(cl.info.max_allocation_bytes)) + ")",
@@ -95,18 +104,10 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   const auto flags_ro = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
   grid_ = cl::Buffer(cl.context, flags_ro, cells * sizeof(cl_int), grid.data());
   cell_ = cl::Buffer(cl.context, flags_ro, n_ * sizeof(cl_uint), cell_of.data());
-  if (precision_ == Precision::Double) {
-    std::vector<double> E(el.youngs_modulus_pa);
-    E_ = cl::Buffer(cl.context, flags_ro, n_ * sizeof(double), E.data());
-  } else {
-    std::vector<float> E(el.youngs_modulus_pa.begin(), el.youngs_modulus_pa.end());
-    E_ = cl::Buffer(cl.context, flags_ro, n_ * sizeof(float), E.data());
-  }
-  u_ = make_state_buffer(to_lattice_frame(el.displacement_m), &el.inverse_mass);
-  v_ = make_state_buffer(std::vector<double>(3 * n_, 0.0), nullptr);
-  u_tmp_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
+  E_ = make_real_buffer(el.youngs_modulus_pa);
+  for (cl::Buffer* b : {&u_, &v_, &u_tmp_, &v_tmp_}) *b = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
+  upload(el.displacement_m, std::vector<double>(3 * n_, 0.0));
   make_hyperelastic_buffers(el);
-  v_tmp_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
 
   const std::size_t wg = kCheckWorkGroup;
   check_groups_ = (n_ + wg - 1) / wg;
@@ -114,7 +115,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   local_ = cl.info.is_gpu ? cl::NDRange(wg) : cl::NullRange;  // PoCL picks faster sizes itself
   check_slots_ = kCheckBaseSlots + kCheckSlotsPerIndenter * int(scene.indenters.size());
   partial_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * check_slots_ * real_size_);
-  make_indenter_table();
+  indenters_ = make_real_buffer(indenter_table());
   partial_arg_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * sizeof(cl_int));
 
   // Only the features this scene uses are compiled in.
@@ -181,24 +182,21 @@ void Simulator::make_hyperelastic_buffers(const ElementArrays& el) {
   std::vector<double> table;
   for (const auto& row : el.material_table) table.insert(table.end(), row.begin(), row.end());
   if (!hyper_) table.assign(12, 0.0);
-  if (precision_ == Precision::Double) {
-    materials_ = cl::Buffer(cl_.context, flags_ro, table.size() * sizeof(double), table.data());
-  } else {
-    std::vector<float> t(table.begin(), table.end());
-    materials_ = cl::Buffer(cl_.context, flags_ro, t.size() * sizeof(float), t.data());
-  }
+  materials_ = make_real_buffer(table);
   const std::size_t matrix_bytes = (hyper_ ? 3 * n_ : 1) * 4 * real_size_;  // 3 rows of real4
   Q_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, matrix_bytes);
   F_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, matrix_bytes);
 }
 
-cl::Buffer Simulator::make_state_buffer(const std::vector<double>& xyz, const std::vector<double>* w) const {
-  const auto flags = CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR;
+cl::Buffer Simulator::make_real_buffer(const std::vector<double>& values) const {
+  const auto flags = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
   if (precision_ == Precision::Double) {
-    auto data = pack4<double>(xyz, w);
+    std::vector<double> data(values);  // the API wants a mutable pointer
     return cl::Buffer(cl_.context, flags, data.size() * sizeof(double), data.data());
   }
-  auto data = pack4<float>(xyz, w);
+  std::vector<float> data(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i)  // "never" (1e300) saturates within float range
+    data[i] = float(std::clamp(values[i], -3e38, 3e38));
   return cl::Buffer(cl_.context, flags, data.size() * sizeof(float), data.data());
 }
 
@@ -244,7 +242,7 @@ Vec3 Simulator::indenter_position(std::size_t i, double t) const {
   return ind.start_m + ind.velocity_m_s * std::min(t, ind.travel_time_s);
 }
 
-void Simulator::make_indenter_table() {
+std::vector<double> Simulator::indenter_table() const {
   // Rows in the lattice frame (kernels/common.cl, VB_INDENTER_PARAMS); a placeholder row if none.
   std::vector<double> table(kIndenterStride * std::max<std::size_t>(1, scene_.indenters.size()), 0.0);
   const Eigen::Matrix3d Rt = lattice_.rotation.transpose();
@@ -256,14 +254,7 @@ void Simulator::make_indenter_table() {
     row[3] = ind.kind == IndenterSpec::Kind::Plate ? -1.0 : ind.radius_m;
     row[12] = std::isfinite(ind.travel_time_s) ? ind.travel_time_s : 1e300;
   }
-  const auto flags = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
-  if (precision_ == Precision::Double) {
-    indenters_ = cl::Buffer(cl_.context, flags, table.size() * sizeof(double), table.data());
-  } else {
-    for (double& x : table) x = std::min(x, 1e30);  // travel time "never" within float range
-    std::vector<float> t(table.begin(), table.end());
-    indenters_ = cl::Buffer(cl_.context, flags, t.size() * sizeof(float), t.data());
-  }
+  return table;
 }
 
 void Simulator::set_indenter_args(cl::Kernel& k, int a, double t_force, double t_project) {

@@ -25,6 +25,11 @@ struct StateCheck {
   std::int64_t fastest_element = -1;  ///< element with the largest speed (or first non-finite)
 };
 
+/// Device bytes a model of `elements` elements in a padded grid of `cells` voxels needs
+/// (hyperelastic models also store F and Q per element).
+std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision,
+                                   bool hyperelastic = false);
+
 class Simulator {
  public:
   /// Uploads the model. Throws vb::Error for double precision on a device without fp64, a model
@@ -67,8 +72,9 @@ class Simulator {
   void enqueue_check() const;
   void enqueue_stress(const cl::Buffer& u);
   void make_hyperelastic_buffers(const ElementArrays& el);
-  void make_indenter_table();
-  cl::Buffer make_state_buffer(const std::vector<double>& xyz, const std::vector<double>* w) const;
+  std::vector<double> indenter_table() const;
+  /// read-only buffer of reals in the run's precision
+  cl::Buffer make_real_buffer(const std::vector<double>& values) const;
 
   const Scene& scene_;
   const Lattice& lattice_;

@@ -29,38 +29,14 @@
 #include <vector>
 
 #include "engine/error.hpp"
+#include "tests/fuzz/fuzz_support.hpp"
 #include "io/dicom_io.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-bool verbose() {
-  static const bool on = std::getenv("VB_FUZZ_VERBOSE") != nullptr;
-  return on;
-}
-
 constexpr int kMaxFiles = 4;
-
-/// One private folder per process under $TMPDIR (or /tmp), removed at exit; it is the series
-/// folder itself.
-const fs::path& work_dir() {
-  // Never destroyed, so that the atexit handler below can still use it at exit.
-  static const fs::path& dir = *new fs::path([] {
-    const char* base = std::getenv("TMPDIR");
-    std::string pattern = std::string(base && *base ? base : "/tmp") + "/vb-fuzz-dicom-XXXXXX";
-    if (!::mkdtemp(pattern.data())) {
-      std::perror("fuzz_dicom_series: mkdtemp");
-      std::abort();
-    }
-    std::atexit([] {
-      std::error_code ignored;
-      fs::remove_all(work_dir(), ignored);
-    });
-    return pattern;
-  }());
-  return dir;
-}
 
 // ---- a minimal Part 10 header (preamble, "DICM", group 0002) ---------------------------------
 
@@ -128,7 +104,7 @@ void write_file(const fs::path& path, const std::string& prefix, const std::uint
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   // A missing data dictionary would turn every input into the same vb::Error: say so at once.
   try {
-    vb::list_dicom_series(work_dir().string());
+    vb::list_dicom_series(vb::fuzz::work_dir("dicom").string());
   } catch (const vb::Error& e) {
     std::fprintf(stderr, "fuzz_dicom_series: DICOM reading is not usable here: %s\n", e.what());
     std::exit(1);
@@ -147,7 +123,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // Only this input's files are in the folder, so a run never depends on the previous input.
   std::error_code ignored;
   for (int n = 0; n < kMaxFiles; ++n)
-    fs::remove(work_dir() / ("f" + std::to_string(n) + ".dcm"), ignored);
+    fs::remove(vb::fuzz::work_dir("dicom") / ("f" + std::to_string(n) + ".dcm"), ignored);
   for (int n = 0; n < files; ++n) {
     std::size_t length = size - at;
     if (n + 1 < files) {
@@ -156,11 +132,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (at < size) declared |= std::size_t(data[at++]) << 8;
       length = std::min(declared, size - at);
     }
-    write_file(work_dir() / ("f" + std::to_string(n) + ".dcm"), prefix, data + at, length);
+    write_file(vb::fuzz::work_dir("dicom") / ("f" + std::to_string(n) + ".dcm"), prefix, data + at, length);
     at += length;
   }
 
-  const std::string dir = work_dir().string();
+  const std::string dir = vb::fuzz::work_dir("dicom").string();
   std::string first_uid;
   try {
     const std::vector<vb::DicomSeriesInfo> series = vb::list_dicom_series(dir);
@@ -171,12 +147,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         std::abort();
       }
     if (!series.empty()) first_uid = series.front().series_uid;
-    if (verbose())
+    if (vb::fuzz::verbose())
       for (const auto& info : series)
         std::fprintf(stderr, "list_dicom_series: %s '%s' %d files\n", info.series_uid.c_str(),
                      info.modality.c_str(), info.files);
   } catch (const vb::Error& e) {
-    if (verbose()) std::fprintf(stderr, "list_dicom_series: vb::Error: %s\n", e.what());
+    if (vb::fuzz::verbose()) std::fprintf(stderr, "list_dicom_series: vb::Error: %s\n", e.what());
   } catch (const std::exception& e) {
     finding("list_dicom_series", e.what());
   }
@@ -195,11 +171,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                    volume.dims[2]);
       std::abort();
     }
-    if (verbose())
+    if (vb::fuzz::verbose())
       std::fprintf(stderr, "read_dicom_series: %dx%dx%d voxels, %zu warnings\n", volume.dims[0],
                    volume.dims[1], volume.dims[2], warnings.size());
   } catch (const vb::Error& e) {
-    if (verbose()) std::fprintf(stderr, "read_dicom_series: vb::Error: %s\n", e.what());
+    if (vb::fuzz::verbose()) std::fprintf(stderr, "read_dicom_series: vb::Error: %s\n", e.what());
   } catch (const std::exception& e) {
     finding("read_dicom_series", e.what());
   }

@@ -24,35 +24,12 @@
 #include <vector>
 
 #include "engine/error.hpp"
+#include "tests/fuzz/fuzz_support.hpp"
 #include "io/nifti_io.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
-
-bool verbose() {
-  static const bool on = std::getenv("VB_FUZZ_VERBOSE") != nullptr;
-  return on;
-}
-
-/// One private folder per process under $TMPDIR (or /tmp), removed at exit.
-const fs::path& work_dir() {
-  // Never destroyed, so that the atexit handler below can still use it at exit.
-  static const fs::path& dir = *new fs::path([] {
-    const char* base = std::getenv("TMPDIR");
-    std::string pattern = std::string(base && *base ? base : "/tmp") + "/vb-fuzz-nifti-XXXXXX";
-    if (!::mkdtemp(pattern.data())) {
-      std::perror("fuzz_nifti: mkdtemp");
-      std::abort();
-    }
-    std::atexit([] {
-      std::error_code ignored;
-      fs::remove_all(work_dir(), ignored);
-    });
-    return pattern;
-  }());
-  return dir;
-}
 
 void write_plain(const fs::path& path, const std::uint8_t* data, std::size_t size) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
@@ -80,8 +57,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint8_t* payload = data + 1;
   const std::size_t payload_size = size - 1;
 
-  const fs::path plain = work_dir() / "input.nii";
-  const fs::path gzip = work_dir() / "input.nii.gz";
+  const fs::path plain = vb::fuzz::work_dir("nifti") / "input.nii";
+  const fs::path gzip = vb::fuzz::work_dir("nifti") / "input.nii.gz";
   // Only the file of this input exists, so a run never depends on the previous input.
   std::error_code ignored;
   fs::remove(plain, ignored);
@@ -102,11 +79,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                    image.values.size(), image.voxel_count());
       std::abort();
     }
-    if (verbose())
+    if (vb::fuzz::verbose())
       std::fprintf(stderr, "read_nifti %s: %dx%dx%d voxels, modality '%s'\n", path.c_str(),
                    image.dims[0], image.dims[1], image.dims[2], image.modality.c_str());
   } catch (const vb::Error& e) {
-    if (verbose()) std::fprintf(stderr, "read_nifti: vb::Error: %s\n", e.what());
+    if (vb::fuzz::verbose()) std::fprintf(stderr, "read_nifti: vb::Error: %s\n", e.what());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fuzz_nifti: read_nifti threw a non-vb::Error exception: %s\n", e.what());
     std::abort();
@@ -121,11 +98,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                      "voxels\n", displacement.size(), grid.voxel_count());
         std::abort();
       }
-      if (verbose())
+      if (vb::fuzz::verbose())
         std::fprintf(stderr, "read_nifti_displacement: %dx%dx%d voxels\n", grid.dims[0],
                      grid.dims[1], grid.dims[2]);
     } catch (const vb::Error& e) {
-      if (verbose()) std::fprintf(stderr, "read_nifti_displacement: vb::Error: %s\n", e.what());
+      if (vb::fuzz::verbose()) std::fprintf(stderr, "read_nifti_displacement: vb::Error: %s\n", e.what());
     } catch (const std::exception& e) {
       std::fprintf(stderr,
                    "fuzz_nifti: read_nifti_displacement threw a non-vb::Error exception: %s\n",

@@ -94,10 +94,5 @@ TEST(ImageLattice, MismatchedLabelGridAndUnknownKeptTissueAreErrors) {
   }
 }
 
-TEST(ImageLattice, DeviceMemoryEstimateScalesWithPrecision) {
-  EXPECT_EQ(estimated_device_bytes(1000, 0, Precision::Float), 1000u * 72);
-  EXPECT_EQ(estimated_device_bytes(1000, 10, Precision::Double), 1000u * 140 + 40);
-}
-
 }  // namespace
 }  // namespace vb
