@@ -178,7 +178,9 @@ inline mat3 stress_ogden(mat3 C, real J, global const real* mat) {
   return S;
 }
 
-// Pass 1: per-element F and Q (rows of 3×3 matrices stored as 3 real4 each).
+// Pass 1: per-element F and Q (rows of 3×3 matrices stored as 3 real4 each). The element's volume
+// is w·h³, w = (complete dual cells around it)/8 (engine/lattice/dual_cells.hpp): then a
+// homogeneous stress is balanced by forces on the surface elements alone, as plates apply them.
 kernel void element_stress(global const real4* u, global const uchar* tissue_of, global const real* materials,
                            global const uint* cell_of, global const int* grid, int sy, int sz, real h,
                            global real4* Q_out, global real4* F_out, uint n) {
@@ -194,9 +196,11 @@ kernel void element_stress(global const real4* u, global const uchar* tissue_of,
   const int cell = (int)cell_of[e];
   const real4 ue = u[e];
   mat3 A = mat3_zero(), B = mat3_zero();  // B in units of h²
+  uint present = 0;
   for (int d = 0; d < 26; ++d) {
     const int j = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
     if (j < 0) continue;
+    present |= 1u << d;
     const real4 uj = u[j];
     const real dX[3] = {VB_DIR[d][0], VB_DIR[d][1], VB_DIR[d][2]};
     const real dx[3] = {h * dX[0] + (uj.x - ue.x), h * dX[1] + (uj.y - ue.y), h * dX[2] + (uj.z - ue.z)};
@@ -220,9 +224,12 @@ kernel void element_stress(global const real4* u, global const uchar* tissue_of,
   const mat3 C = mat3_transpose_mul(F, F);
   const mat3 S = law == 1 ? stress_invariants(C, J, (real)0.5 * mat[2], (real)-0.5 * mat[3], mat[8])
                           : stress_ogden(C, J, mat);
-  mat3 Q = mat3_mul(mat3_mul(F, S), Bi);  // V·P·B⁻¹ with V = h³ and B = h²·B' → h·P·B'⁻¹
+  int cells = 0;
+  for (int o = 0; o < 8; ++o) cells += (present & VB_OCTANT_MASK[o]) == VB_OCTANT_MASK[o];
+  mat3 Q = mat3_mul(mat3_mul(F, S), Bi);  // V·P·B⁻¹ with V = w·h³ and B = h²·B' → w·h·P·B'⁻¹
+  const real wh = (real)0.125 * cells * h;
   for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) Q.m[a][b] *= h;
+    for (int b = 0; b < 3; ++b) Q.m[a][b] *= wh;
   mat3_store(Q_out, e, Q);
   mat3_store(F_out, e, F);
 }

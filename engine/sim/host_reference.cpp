@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 
+#include "engine/lattice/dual_cells.hpp"
 #include "engine/material/hyperelastic.hpp"
 #include "engine/material/linear_spring.hpp"
 
@@ -73,7 +74,7 @@ void HostReference::element_stresses(const std::vector<double>& u, std::vector<E
     if (B.determinant() < 0.5) continue;  // as the kernel: neighbours do not span 3-D
     const Eigen::Matrix3d Bi = B.inverse();
     F[e] = A * Bi / h;
-    Q[e] = h * first_piola(*law, F[e]) * Bi;
+    Q[e] = dual_volume_fraction(neighbours_[e]) * h * first_piola(*law, F[e]) * Bi;  // V = w·h³
   }
 }
 

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "engine/lattice/dual_cells.hpp"
 #include "engine/lattice/lattice.hpp"
 #include "engine/material/linear_spring.hpp"
 
@@ -27,6 +28,8 @@ std::string lattice_tables_source() {
   for (int d = 0; d < 26; ++d) s << "(real)" << exact(ls::rest_length_factor(d)) << ",";
   s << "};\n__constant real VB_KAPPA[26] = {";
   for (int d = 0; d < 26; ++d) s << "(real)" << exact(ls::kappa(d)) << ",";
+  s << "};\n__constant uint VB_OCTANT_MASK[8] = {";
+  for (const std::uint32_t m : octant_masks()) s << m << "u,";
   s << "};\n";
   return s.str();
 }

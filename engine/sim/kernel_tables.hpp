@@ -5,7 +5,7 @@
 
 namespace vb {
 
-/// `__constant` arrays VB_DIR, VB_DIR_LEN, VB_KAPPA typed with `real` (so it must follow common.cl).
+/// `__constant` arrays VB_DIR, VB_DIR_LEN, VB_KAPPA, VB_OCTANT_MASK (dual cells) typed with `real` (so it must follow common.cl).
 std::string lattice_tables_source();
 
 }  // namespace vb
