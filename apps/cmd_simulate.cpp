@@ -5,6 +5,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/image_outputs.hpp"
+#include "apps/mesh_outputs.hpp"
 #include "apps/progress.hpp"
 #include "apps/simulation_setup.hpp"
 #include "engine/sim/run.hpp"
@@ -49,6 +50,7 @@ int run_simulate(const SimulateOptions& o) {
     summary["image_outputs"] = write_image_outputs(o.out, scene, model.lattice, *model.ct, result.state);
     summary["warnings"] = model.warnings;
   }
+  if (scene.output.surfaces) summary["mesh_outputs"] = write_mesh_outputs(o.out, model.lattice, result.state, result.frames);
   write_text_atomically(json, summary.dump(2) + "\n");
   const RunSummary& s = result.summary;
   std::printf("%s after %lld steps (%.4g s simulated, %.1f s wall, %.0f steps/s); max displacement %.3f mm\n",
@@ -57,6 +59,7 @@ int run_simulate(const SimulateOptions& o) {
   for (const std::string& w : model.warnings) std::fprintf(stderr, "voxbreast: warning: %s\n", w.c_str());
   std::printf("wrote %s\nwrote %s\n", json.c_str(), h5.c_str());
   if (model.ct) std::printf("wrote DVF, warped CT and fields on the CT grid in %s/\n", o.out.c_str());
+  if (scene.output.surfaces) std::printf("wrote surface meshes (.vtp, .stl, .ply) and lattice.vtu in %s/\n", o.out.c_str());
   return 0;
 }
 

@@ -60,6 +60,7 @@ json summary_to_json(const RunSummary& s, const Scene& scene) {
       {"final_speed_ratio", number(s.final_speed_ratio)},
       {"max_displacement_m", number(s.max_displacement_m)},
       {"volume_change_fraction", number(s.volume_change)},
+      {"surface_volume_change_fraction", number(s.surface_volume_change)},
       {"device", {{"name", s.device_name}, {"precision", s.precision}}},
       {"integrator", s.integrator},
       {"tracked", tracked_to_json(s.tracked)},

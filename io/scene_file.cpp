@@ -514,8 +514,8 @@ ModelSpec read_model(const Section& s) {
 }
 
 void check_law(const Section& s, const std::string& law) {
-  const Keys available = {"linear", "neo-hookean", "mooney-rivlin", "ogden"};
-  const Keys later = {"biphasic_spring"};
+  const Keys available = {"linear", "biphasic", "neo-hookean", "mooney-rivlin", "ogden"};
+  const Keys later = {};
   if (contains(available, law)) return;
   if (contains(later, law)) s.fail("law", "law '" + law + "' is not available in this version", "use " + joined(available));
   s.fail("law", "unknown law '" + law + "'", choice_hint(law, available));
@@ -524,6 +524,7 @@ void check_law(const Section& s, const std::string& law) {
 /// Keys each law reads; any other law key in the table is a mix-up and an error.
 const std::map<std::string, Keys> kLawKeys = {
     {"linear", {"E"}},
+    {"biphasic", {"E", "cubic", "critical_strain"}},
     {"neo-hookean", {"E", "nu", "bulk_modulus"}},
     {"mooney-rivlin", {"c10", "c01", "nu", "bulk_modulus"}},
     {"ogden", {"mu", "alpha", "nu", "bulk_modulus"}},
@@ -531,7 +532,8 @@ const std::map<std::string, Keys> kLawKeys = {
 
 /// A tissue with a default (docs/MATERIALS.md) may give only the values it changes.
 MaterialSpec read_material(const std::string& name, const Section& s) {
-  s.check_keys({"law", "E", "density", "nu", "rigid", "bulk_modulus", "c10", "c01", "mu", "alpha"});
+  s.check_keys({"law", "E", "density", "nu", "rigid", "bulk_modulus", "c10", "c01", "mu", "alpha", "cubic",
+                "critical_strain"});
   const std::optional<MaterialSpec> fallback = default_material(name);
   MaterialSpec m = fallback.value_or(MaterialSpec{});
   m.name = name;
@@ -539,17 +541,18 @@ MaterialSpec read_material(const std::string& name, const Section& s) {
   const std::optional<std::string> law = s.text("law");
   if (law) {
     m.law = *law == "neo_hookean" ? "neo-hookean" : *law == "mooney_rivlin" ? "mooney-rivlin" : *law;
+    if (m.law == "biphasic_spring") m.law = "biphasic";
     check_law(s, m.law);
   }
-  for (const char* key : {"E", "nu", "bulk_modulus", "c10", "c01", "mu", "alpha"}) {
+  for (const char* key : {"E", "nu", "bulk_modulus", "c10", "c01", "mu", "alpha", "cubic", "critical_strain"}) {
     if (!s.find(key) || contains(kLawKeys.at(m.law), key)) continue;
-    if (m.law == "linear" && std::string_view(key) == "nu")
-      s.fail(key, "linear lattice springs have Poisson ratio 0.25 fixed; 'nu' applies to hyperelastic laws", "remove 'nu'");
+    if ((m.law == "linear" || m.law == "biphasic") && std::string_view(key) == "nu")
+      s.fail(key, m.law + " lattice springs have Poisson ratio 0.25 fixed; 'nu' applies to hyperelastic laws", "remove 'nu'");
     s.fail(key, "'" + std::string(key) + "' does not apply to law '" + m.law + "'", "keys for this law: " + joined(kLawKeys.at(m.law)));
   }
   m.rigid = s.boolean("rigid").value_or(m.rigid);
   const std::optional<double> E = s.positive("E");
-  const bool needs_E = m.law == "linear" || m.law == "neo-hookean";
+  const bool needs_E = m.law == "linear" || m.law == "biphasic" || m.law == "neo-hookean";
   if (needs_E && !E && !fallback && !m.rigid) s.fail("E", "missing required key", "'" + name + "' has no default material");
   m.youngs_modulus_pa = E.value_or(fallback ? fallback->youngs_modulus_pa : m.rigid ? 1e12 : 0.0);
   m.density_kg_m3 = s.positive("density").value_or(m.density_kg_m3);
@@ -561,7 +564,13 @@ MaterialSpec read_material(const std::string& name, const Section& s) {
   m.ogden_alpha = s.numbers("alpha").value_or(std::vector<double>{});
   if (m.law == "mooney-rivlin" && !s.find("c10")) s.fail("c10", "missing required key");
   if (m.law == "ogden" && !(s.find("mu") && s.find("alpha"))) s.fail(s.find("mu") ? "alpha" : "mu", "missing required key");
-  if (m.law != "linear" && !m.rigid) {
+  if (m.law == "biphasic") {
+    m.cubic = s.required("cubic", s.non_negative("cubic"));
+    m.critical_strain = s.required("critical_strain", s.number("critical_strain"));
+    if (!(m.critical_strain > 0 && m.critical_strain < 1))
+      s.fail("critical_strain", "must be in (0, 1), got " + format_number(m.critical_strain), "e.g. 0.1");
+  }
+  if (m.law != "linear" && m.law != "biphasic" && !m.rigid) {
     try {
       (void)law_of(m);  // parameters that make no material fail here, at their line
     } catch (const Error& e) {
@@ -666,8 +675,14 @@ AnchorSpec read_anchor(const std::string& name, const Section& s) {
 }
 
 const NameTable<IndenterSpec::Kind> kIndenterKinds = {
-    {"sphere", IndenterSpec::Kind::Sphere, {"kind", "radius", "start", "velocity", "travel_time"}},
-    {"plate", IndenterSpec::Kind::Plate, {"kind", "start", "normal", "velocity", "travel_time"}},
+    {"sphere", IndenterSpec::Kind::Sphere, {"kind", "radius", "start", "velocity", "travel_time", "contact"}},
+    {"plate", IndenterSpec::Kind::Plate, {"kind", "start", "normal", "velocity", "travel_time", "contact"}},
+};
+
+const NameTable<IndenterSpec::Contact> kContacts = {
+    {"push", IndenterSpec::Contact::Push, {}},
+    {"slide", IndenterSpec::Contact::Slide, {}},
+    {"stick", IndenterSpec::Contact::Stick, {}},
 };
 
 IndenterSpec read_indenter(const Section& s) {
@@ -679,6 +694,7 @@ IndenterSpec read_indenter(const Section& s) {
   i.start_m = s.required("start", s.vec3("start"));
   i.velocity_m_s = s.vec3("velocity").value_or(i.velocity_m_s);
   i.travel_time_s = s.positive("travel_time").value_or(i.travel_time_s);
+  if (const auto* n = s.named("contact", kContacts)) i.contact = n->value;
   return i;
 }
 
@@ -710,8 +726,17 @@ StopSpec read_stop(const Section& s) {
   return stop;
 }
 
+VolumeSpec read_volume(const Section& s) {
+  s.check_keys({"preserve", "every"});
+  VolumeSpec volume;
+  volume.preserve = s.boolean("preserve").value_or(volume.preserve);
+  volume.every = s.integer<int>("every", 1).value_or(volume.every);
+  volume.line = s.line();
+  return volume;
+}
+
 OutputSpec read_output(const Section& s, const ModelSpec& model) {
-  s.check_keys({"frames_every", "dvf", "warped_ct", "warped_ct_dicom", "fields"}, {{"surfaces", kLaterVersion}});
+  s.check_keys({"frames_every", "dvf", "warped_ct", "warped_ct_dicom", "fields", "surfaces"});
   OutputSpec out;
   out.frames_every = s.integer<int>("frames_every", 0).value_or(out.frames_every);
   for (const char* key : {"dvf", "warped_ct", "warped_ct_dicom", "fields"}) {
@@ -721,6 +746,7 @@ OutputSpec read_output(const Section& s, const ModelSpec& model) {
   out.warped_ct = s.boolean("warped_ct").value_or(out.warped_ct);
   out.warped_ct_dicom = s.boolean("warped_ct_dicom").value_or(out.warped_ct_dicom);
   out.fields = s.boolean("fields").value_or(out.fields);
+  out.surfaces = s.boolean("surfaces").value_or(out.surfaces);
   return out;
 }
 
@@ -785,8 +811,8 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
   const toml::table root = parse_toml(text, source_name);
   const Section top(root, "", source_name);
   top.check_keys(
-      {"model", "materials", "solver", "gravity", "anchor", "indenter", "track", "stop", "output"},
-      {{"volume", kLaterVersion}, {"device", kLaterVersion}});
+      {"model", "materials", "solver", "gravity", "anchor", "indenter", "track", "stop", "output", "volume"},
+      {{"device", kLaterVersion}});
   Scene scene;
   scene.model = read_model(top.table_or_empty("model"));
   scene.materials = read_materials(top.table_or_empty("materials"));
@@ -799,6 +825,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
   scene.tracks = read_tracks(top.tables("track"));
   scene.stop = read_stop(top.table_or_empty("stop"));
   scene.output = read_output(top.table_or_empty("output"), scene.model);
+  if (const auto volume = top.table("volume")) scene.volume = read_volume(*volume);
   check_labels(scene, source_name);
   scene.source_text = text;
   return scene;

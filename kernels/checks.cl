@@ -5,11 +5,17 @@
 //   4 non-finite elements
 //   5 + 4i .. 7 + 4i  force of the tissue on indenter i (N), 8 + 4i  its contact elements
 // `partial_arg` holds, per group, the element with the largest speed (first non-finite wins).
+// With VB_VOLUME the residual is that of the constrained problem: the pressure term p·g
+// (kernels/volume.cl, computed just before) is taken off the static force of surface elements.
 #define VB_SLOT_SUM(s) ((s) == 2 || (s) >= 4)
 
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
 void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS,
-                 VB_INDENTER_PARAMS, global real* partial, global int* partial_arg, uint n) {
+                 VB_INDENTER_PARAMS, global real* partial, global int* partial_arg, uint n
+#if VB_VOLUME
+                 , global const real4* volume_grad, global const real* volume_scalars
+#endif
+                 ) {
   local real s[VB_CHECK_SLOTS][VB_CHECK_WG];
   local int s_arg[VB_CHECK_WG];
   const uint e = get_global_id(0), l = get_local_id(0);
@@ -25,6 +31,9 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
     value[4] = finite ? 0 : 1;
     if (finite && ui.w != 0) {
       real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
+#if VB_VOLUME
+      f -= volume_scalars[3] * volume_grad[e];
+#endif
 #if VB_INDENTERS
       const real4 x = rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui);
       for (int i = 0; i < VB_INDENTERS; ++i) {

@@ -4,7 +4,9 @@
 //                     so only what the scene uses is compiled
 //   -DVB_RSQRT=0|1    1/|r| by rsqrt (GPUs) or 1/sqrt (CPUs, where rsqrt is a library call)
 //   -DVB_HYPER=0|1    hyperelastic tissues present (kernels/hyperelastic.cl)
+//   -DVB_BIPHASIC=0|1 biphasic-spring tissues present (kernels/lattice_forces.cl)
 //   -DVB_CHECK_WG=N   work-group size of the reduction kernel
+//   -DVB_VOLUME=0|1   volume-preservation constraint on (kernels/volume.cl)
 // and prepends the lattice tables (VB_DIR, VB_DIR_LEN, VB_KAPPA) generated from the host's
 // single definition (engine/sim/kernel_tables.cpp).
 #if VB_DOUBLE
@@ -34,7 +36,7 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
 
 // Parameters every stepping kernel takes, in this order (the host sets them in one place).
 // Hyperelastic data (tissue_of, materials, Qs, Fs, hourglass) are 1-element placeholders when
-// VB_HYPER is 0.
+// VB_HYPER is 0; tissue_of and materials are real when VB_BIPHASIC is 1.
 #define VB_LATTICE_PARAMS                                                                        \
   global const real *E, global const uint *cell_of, global const int *grid, int sy, int sz,    \
       real h, real dashpot_ratio, real4 gravity, real damping, real4 origin,                   \
@@ -44,7 +46,8 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
   E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity, damping, origin, tissue_of, materials, Qs, Fs, hourglass
 // Rigid indenters: a table of VB_INDENTERS rows (lattice frame, VB_IND_STRIDE reals each:
 // 0–2 start (m), 3 radius (m; < 0 for a plate), 4–6 plate normal into the tissue, 8–10
-// velocity (m/s), 12 travel time (s)), the time forces are evaluated at, and the time stage
+// velocity (m/s), 12 travel time (s), 13 contact: 0 push, 1 slide, 2 stick), the time forces are
+// evaluated at, and the time stage
 // positions are projected at. A 1-element placeholder when VB_INDENTERS is 0.
 #define VB_IND_STRIDE 16
 #define VB_INDENTER_PARAMS global const real *indenters, real t_force, real t_project

@@ -6,10 +6,19 @@
 // gathers them in lattice_force): total force and torque vanish and rigid motions give none.
 //
 // Material table (global const real*, VB_MAT_STRIDE reals per tissue):
-//   0 law (0 linear springs, 1 neo-Hookean/Mooney-Rivlin by invariants, 2 Ogden by stretches)
+//   0 law (0 linear springs, 1 neo-Hookean/Mooney-Rivlin by invariants, 2 Ogden by stretches,
+//     3 biphasic springs)
 //   1 terms N, 2..4 μ_p (Pa), 5..7 α_p, 8 κ (Pa)
-#if VB_HYPER
+//   9 c3, 10 εc (biphasic springs, kernels/lattice_forces.cl); 11 unused
+// Laws 0 and 3 are spring tissues: no element stress (Q = 0, F = I).
 #define VB_MAT_STRIDE 12
+#define VB_LAW_BIPHASIC 3
+#if VB_BIPHASIC
+#define VB_LAW_HYPER(law) ((law) != 0 && (law) != VB_LAW_BIPHASIC)
+#else
+#define VB_LAW_HYPER(law) ((law) != 0)
+#endif
+#if VB_HYPER
 
 typedef struct {
   real m[3][3];
@@ -84,15 +93,28 @@ inline mat3 mat3_load(global const real4* rows, uint e) {
   return a;
 }
 
-// J clamped for the isochoric terms: an inverted or crushed element (J ≤ 0) keeps finite
-// stresses while the volumetric term κJ(J − 1) pushes it back open.
+// J clamped for the isochoric terms: W_iso uses J_c = max(J, floor), so below the floor J_c is a
+// constant and the isochoric stress has no C⁻¹ (J-derivative) term. The volumetric stress is
+// added as P_vol = κ(J − 1)·cof F (= κJ(J − 1)·F⁻ᵀ), which needs no inverse. Both stay finite for a
+// crushed (J = 0) or inverted (J < 0) element, and κ(J − 1)·cof F pushes it back towards J = 1.
 #define VB_J_FLOOR ((real)0.05)
 
-// Second Piola-Kirchhoff stress of Mooney-Rivlin (neo-Hookean when C01 = 0) from invariants:
-//   S = 2C10 J^(−2/3)(I − I1/3 C⁻¹) + 2C01 J^(−4/3)(I1 I − C − 2/3 I2 C⁻¹) + κJ(J − 1) C⁻¹
-inline mat3 stress_invariants(mat3 C, real J, real c10, real c01, real kappa) {
-  const real detC = mat3_det(C);
-  const mat3 Ci = mat3_inverse(C, detC);
+// cof F = J·F⁻ᵀ: columns f2×f3, f3×f1, f1×f2 of F's columns f1, f2, f3
+inline mat3 mat3_cofactor(mat3 F) {
+  mat3 r;
+  for (int c = 0; c < 3; ++c) {
+    const int a = (c + 1) % 3, b = (c + 2) % 3;
+    r.m[0][c] = F.m[1][a] * F.m[2][b] - F.m[2][a] * F.m[1][b];
+    r.m[1][c] = F.m[2][a] * F.m[0][b] - F.m[0][a] * F.m[2][b];
+    r.m[2][c] = F.m[0][a] * F.m[1][b] - F.m[1][a] * F.m[0][b];
+  }
+  return r;
+}
+
+// Isochoric second Piola-Kirchhoff stress of Mooney-Rivlin (neo-Hookean when C01 = 0) from
+// invariants: S = 2C10 J^(−2/3)(I − I1/3 C⁻¹) + 2C01 J^(−4/3)(I1 I − C − 2/3 I2 C⁻¹) (the C⁻¹ terms
+// only above the floor)
+inline mat3 stress_invariants(mat3 C, real J, real c10, real c01) {
   const real I1 = C.m[0][0] + C.m[1][1] + C.m[2][2];
   real I2 = 0;
   for (int i = 0; i < 3; ++i)
@@ -100,13 +122,13 @@ inline mat3 stress_invariants(mat3 C, real J, real c10, real c01, real kappa) {
   I2 = (real)0.5 * (I1 * I1 + I2);
   const real Jc = fmax(J, VB_J_FLOOR);
   const real a = 2 * c10 * pow(Jc, (real)(-2.0 / 3.0)), b = 2 * c01 * pow(Jc, (real)(-4.0 / 3.0));
-  const real vol = kappa * J * (J - 1);
+  mat3 Ci = mat3_zero();  // C⁻¹ where J_c follows J; det C = J² ≥ floor² there
+  if (J > VB_J_FLOOR) Ci = mat3_inverse(C, mat3_det(C));
   mat3 S;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       const real id = i == j ? 1 : 0;
-      S.m[i][j] = a * (id - I1 / 3 * Ci.m[i][j]) + b * (I1 * id - C.m[i][j] - (real)(2.0 / 3.0) * I2 * Ci.m[i][j]) +
-                  vol * Ci.m[i][j];
+      S.m[i][j] = a * (id - I1 / 3 * Ci.m[i][j]) + b * (I1 * id - C.m[i][j] - (real)(2.0 / 3.0) * I2 * Ci.m[i][j]);
     }
   return S;
 }
@@ -144,20 +166,21 @@ inline void eigen_symmetric(mat3 C, real w[3], mat3* V) {
   for (int i = 0; i < 3; ++i) w[i] = A.m[i][i];
 }
 
-// Ogden from principal stretches: τ_i = Σ_p μ_p(λ̄_i^α_p − ⅓Σ_k λ̄_k^α_p) + κJ(J − 1);
-// S = Σ τ_i/λ_i² N_i N_iᵀ.
+// Isochoric Ogden stress from principal stretches: τ_i = Σ_p μ_p(λ̄_i^α_p − ⅓Σ_k λ̄_k^α_p) (the ⅓Σ
+// term only above the floor); S = Σ τ_i/λ_i² N_i N_iᵀ.
 inline mat3 stress_ogden(mat3 C, real J, global const real* mat) {
   real w[3];
   mat3 N;
   eigen_symmetric(C, w, &N);
   const real Jc = fmax(J, VB_J_FLOOR);
   const real scale = pow(Jc, (real)(-1.0 / 3.0));
+  const real mean = J > VB_J_FLOOR ? (real)(1.0 / 3.0) : 0;
   real tau[3];
   real lbar[3];
   for (int i = 0; i < 3; ++i) {
     w[i] = fmax(w[i], (real)1e-12);
     lbar[i] = sqrt(w[i]) * scale;
-    tau[i] = mat[8] * J * (J - 1);
+    tau[i] = 0;
   }
   const int terms = (int)mat[1];
   for (int p = 0; p < terms; ++p) {
@@ -167,7 +190,7 @@ inline mat3 stress_ogden(mat3 C, real J, global const real* mat) {
       la[i] = pow(lbar[i], alpha);
       sum += la[i];
     }
-    for (int i = 0; i < 3; ++i) tau[i] += mu * (la[i] - sum / 3);
+    for (int i = 0; i < 3; ++i) tau[i] += mu * (la[i] - mean * sum);
   }
   mat3 S = mat3_zero();
   for (int i = 0; i < 3; ++i) {
@@ -188,7 +211,7 @@ kernel void element_stress(global const real4* u, global const uchar* tissue_of,
   if (e >= n) return;
   global const real* mat = materials + VB_MAT_STRIDE * tissue_of[e];
   const int law = (int)mat[0];
-  if (law == 0) {  // linear-spring tissue: no element stress
+  if (!VB_LAW_HYPER(law)) {  // spring tissue: no element stress
     mat3_store(Q_out, e, mat3_zero());
     mat3_store(F_out, e, mat3_identity());
     return;
@@ -222,11 +245,16 @@ kernel void element_stress(global const real4* u, global const uchar* tissue_of,
     for (int b = 0; b < 3; ++b) F.m[a][b] /= h;
   const real J = mat3_det(F);
   const mat3 C = mat3_transpose_mul(F, F);
-  const mat3 S = law == 1 ? stress_invariants(C, J, (real)0.5 * mat[2], (real)-0.5 * mat[3], mat[8])
+  const mat3 S = law == 1 ? stress_invariants(C, J, (real)0.5 * mat[2], (real)-0.5 * mat[3])
                           : stress_ogden(C, J, mat);
+  mat3 P = mat3_mul(F, S);  // isochoric part, then the volumetric κ(J − 1)·cof F
+  const mat3 cof = mat3_cofactor(F);
+  const real vol = mat[8] * (J - 1);
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) P.m[a][b] += vol * cof.m[a][b];
   int cells = 0;
   for (int o = 0; o < 8; ++o) cells += (present & VB_OCTANT_MASK[o]) == VB_OCTANT_MASK[o];
-  mat3 Q = mat3_mul(mat3_mul(F, S), Bi);  // V·P·B⁻¹ with V = w·h³ and B = h²·B' → w·h·P·B'⁻¹
+  mat3 Q = mat3_mul(P, Bi);  // V·P·B⁻¹ with V = w·h³ and B = h²·B' → w·h·P·B'⁻¹
   const real wh = (real)0.125 * cells * h;
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) Q.m[a][b] *= wh;

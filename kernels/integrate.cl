@@ -19,7 +19,7 @@ inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, glo
 inline void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_of, int sy, int sz,
                          real4 origin, real h, global const real* indenters, real t) {
 #if VB_INDENTERS
-  contact_project_all(un, vn, rest_position(cell_of[e], sy, sz, origin, h), indenters, t);
+  contact_project_all(un, vn, rest_position(cell_of[e], sy, sz, origin, h), indenters, t, h);
 #endif
 }
 

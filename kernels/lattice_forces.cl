@@ -4,18 +4,43 @@
 // A connection's stiffness is k = κ_d · h · E_ij, where κ_d is the direction class's coefficient
 // (docs/PHYSICS.md) and E_ij = 2·E_i·E_j/(E_i+E_j) joins the two halves in series.
 
+#if VB_BIPHASIC
+// Biphasic spring (docs/PHYSICS.md, "Biphasic springs"): force over k·L at strain ε,
+//   g(ε) = ε + c3·ε³ for |ε| ≤ εc,  sgn(ε)·(εc + c3·εc³ + (1 + 3·c3·εc²)·(|ε| − εc)) beyond.
+// With m = min(|ε|, εc) both pieces are one expression (no branch).
+inline real biphasic_force_factor(real eps, real c3, real ec) {
+  const real a = fabs(eps), m = fmin(a, ec);
+  return copysign(m * (1 + c3 * m * m) + (1 + 3 * c3 * m * m) * (a - m), eps);
+}
+
+// Half a spring from one end of a connection (N): ½k(|r| − L) for a linear end, ½k·L·g(ε) with
+// the end's own tissue's c3 and εc (material table slots 9 and 10) for a biphasic end. Both are
+// computed and one selected, so CPU compilers can still vectorise across work-items.
+inline real spring_end(int law, global const real* mat, real k, real len, real rest) {
+  const real stretch = len - rest;
+  const real biphasic = rest * biphasic_force_factor(stretch / rest, mat[9], mat[10]);
+  return (real)0.5 * k * (law == VB_LAW_BIPHASIC ? biphasic : stretch);
+}
+#else
+#define spring_end(law, mat, k, len, rest) ((real)0.5 * (k) * ((len) - (rest)))
+#endif
+
 // Force on element e from its connections (N). Linear-spring tissues: springs k = κ_d·h·E_ij.
 // Hyperelastic tissues (VB_HYPER): the element stresses of pass 1 (Q·h·d from each neighbour,
 // Q_e·Σh·d from the element itself) plus hourglass control. Per connection, each end adds half a
-// spring: a linear end ½k(|r| − L), a hyperelastic end c_hg·k(|r| − |F·h·d|), whose rest length is
-// the length its own affine fit predicts, so affine fields feel no hourglass force.
+// spring: a linear end ½k(|r| − L), a biphasic end ½k·L·g(ε) (VB_BIPHASIC), a hyperelastic end
+// c_hg·k(|r| − |F·h·d|), whose rest length is the length its own affine fit predicts, so affine
+// fields feel no hourglass force.
 // u: displacement (m) with w = inverse mass (1/kg, 0 = held); v: velocity (m/s).
 real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v, VB_LATTICE_PARAMS) {
   const int cell = (int)cell_of[e];
   const real Ei = E[e];
   real4 f = (real4)(0);
+#if VB_HYPER || VB_BIPHASIC
+  global const real* mat_i = materials + VB_MAT_STRIDE * tissue_of[e];
+  const int law_i = (int)mat_i[0];
+#endif
 #if VB_HYPER
-  const int law_i = (int)materials[VB_MAT_STRIDE * tissue_of[e]];
   const mat3 Fi = mat3_load(Fs, e);
   real4 own_offsets = (real4)(0);
 #endif
@@ -31,22 +56,29 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
     const real4 r = (real4)(hd.x + (uj.x - ui.x), hd.y + (uj.y - ui.y), hd.z + (uj.z - ui.z), 0);
     const real len_sq = dot3(r, r);
 #if VB_RSQRT
-    const real inv_len = rsqrt(len_sq);  // a hardware instruction on GPUs
+    const real inv_len_raw = rsqrt(len_sq);  // a hardware instruction on GPUs
 #else
-    const real inv_len = 1 / sqrt(len_sq);  // PoCL's rsqrt() is a slow library call (3× here)
+    const real inv_len_raw = 1 / sqrt(len_sq);  // PoCL's rsqrt() is a slow library call (3× here)
 #endif
+    const real inv_len = len_sq > 0 ? inv_len_raw : (real)0;  // coincident neighbours: no direction, no NaN
     const real len = len_sq * inv_len;
     const real4 n = r * inv_len;
     const real Ej = E[j];
     const real k = present * VB_KAPPA[d] * h * (2 * Ei * Ej / (Ei + Ej));
     const real rest = h * VB_DIR_LEN[d];
+#if VB_HYPER || VB_BIPHASIC
+    global const real* mat_j = materials + VB_MAT_STRIDE * tissue_of[j];
+    const int law_j = (int)mat_j[0];
+#endif
 #if VB_HYPER
-    const int law_j = (int)materials[VB_MAT_STRIDE * tissue_of[j]];
-    real magnitude = law_i == 0 ? (real)0.5 * k * (len - rest) : hourglass * k * (len - length(mat3_apply(Fi, hd)));
-    magnitude += law_j == 0 ? (real)0.5 * k * (len - rest)
-                            : hourglass * k * (len - length(mat3_apply(mat3_load(Fs, (uint)j), hd)));
-    if (law_j != 0) f += present * mat3_apply(mat3_load(Qs, (uint)j), hd);
+    real magnitude = !VB_LAW_HYPER(law_i) ? spring_end(law_i, mat_i, k, len, rest)
+                                          : hourglass * k * (len - length(mat3_apply(Fi, hd)));
+    magnitude += !VB_LAW_HYPER(law_j) ? spring_end(law_j, mat_j, k, len, rest)
+                                      : hourglass * k * (len - length(mat3_apply(mat3_load(Fs, (uint)j), hd)));
+    if (VB_LAW_HYPER(law_j)) f += present * mat3_apply(mat3_load(Qs, (uint)j), hd);
     own_offsets += present * hd;
+#elif VB_BIPHASIC
+    real magnitude = spring_end(law_i, mat_i, k, len, rest) + spring_end(law_j, mat_j, k, len, rest);
 #else
     real magnitude = k * (len - rest);
 #endif
@@ -57,7 +89,7 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
     f += magnitude * n;
   }
 #if VB_HYPER
-  if (law_i != 0) f += mat3_apply(mat3_load(Qs, e), own_offsets);
+  if (VB_LAW_HYPER(law_i)) f += mat3_apply(mat3_load(Qs, e), own_offsets);
 #endif
   return f;
 }
@@ -95,14 +127,23 @@ inline real indenter_distance(real4 x, global const real* ind, real t, real4* n_
   return dist - ind[3];
 }
 
-// Frictionless unilateral contact: a touching element cannot be pushed into the indenter, so the
-// inward normal part of its force is carried by the indenter. Returns that part (force on the
-// indenter, N) and removes it from f.
+// Contact of a touching element (within REAL_CONTACT_TOL·h of the surface). Push: frictionless
+// and unilateral, the indenter carries the inward normal part of the element's force. Slide: held
+// on the surface, the indenter carries the whole normal part (pull too), the element slides
+// freely along it. Stick: the element moves with the indenter, which carries all of its force.
+// Returns the part carried (force on the indenter, N) and removes it from f.
 inline real4 contact_constrain(real4* f, real4 x, global const real* ind, real t, real h) {
   real4 n;
   const real dist = indenter_distance(x, ind, t, &n);
+  const int mode = (int)ind[13];
+  if (dist > REAL_CONTACT_TOL * h || (mode != 0 && dist < -REAL_CONTACT_TOL * h)) return (real4)(0);
+  if (mode == 2) {
+    const real4 all = xyz0(*f);
+    *f -= all;
+    return all;
+  }
   const real fn = dot3(*f, n);
-  if (dist > REAL_CONTACT_TOL * h || fn >= 0) return (real4)(0);
+  if (mode == 0 && fn >= 0) return (real4)(0);
   *f -= fn * n;
   return fn * n;
 }
@@ -112,16 +153,21 @@ inline void contact_constrain_all(real4* f, real4 x, global const real* indenter
 }
 
 // Moves an element that ended inside an indenter back onto its surface; its normal velocity
-// becomes at least the indenter's.
-inline void contact_project_all(real4* ui, real4* vi, real4 X, global const real* indenters, real t) {
+// becomes at least the indenter's (push). A held element (slide, stick: within the contact
+// tolerance) is put back on the surface and takes the indenter's normal velocity (slide) or its
+// whole velocity (stick).
+inline void contact_project_all(real4* ui, real4* vi, real4 X, global const real* indenters, real t, real h) {
   for (int i = 0; i < VB_INDENTERS; ++i) {
     global const real* ind = indenters + VB_IND_STRIDE * i;
+    const int mode = (int)ind[13];
     real4 n;
     const real dist = indenter_distance(X + xyz0(*ui), ind, t, &n);
-    if (dist >= 0) continue;
+    if (mode == 0 ? dist >= 0 : fabs(dist) > REAL_CONTACT_TOL * h) continue;
     *ui -= dist * n;
-    const real vn = dot3(*vi, n), wn = dot3(indenter_velocity(ind, t), n);
-    if (vn < wn) *vi += (wn - vn) * n;
+    const real4 w = indenter_velocity(ind, t);
+    const real vn = dot3(*vi, n), wn = dot3(w, n);
+    if (mode == 2) *vi = w;
+    else if (mode == 1 || vn < wn) *vi += (wn - vn) * n;
   }
 }
 #endif

@@ -10,7 +10,7 @@ packages=(
   libgtest-dev googletest
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
   libdcmtk-dev dcmtk libnifti2-dev python3-pydicom python3-nibabel clang libclang-rt-14-dev
-  python3 python3-matplotlib python3-numpy python3-h5py
+  python3 python3-matplotlib python3-numpy python3-h5py python3-vtk9
 )
 
 missing=()

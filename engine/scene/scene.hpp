@@ -52,10 +52,10 @@ struct ModelSpec {
   bool from_image() const { return !image_path.empty(); }
 };
 
-/// Per-tissue material: linear lattice springs, or a hyperelastic law (docs/PHYSICS.md).
+/// Per-tissue material: linear or biphasic lattice springs, or a hyperelastic law (docs/PHYSICS.md).
 struct MaterialSpec {
   std::string name;
-  std::string law = "linear";  ///< linear | neo-hookean | mooney-rivlin | ogden
+  std::string law = "linear";  ///< linear | biphasic | neo-hookean | mooney-rivlin | ogden
   double youngs_modulus_pa = 0;
   double density_kg_m3 = 1000;
   double poisson_ratio = 0.45;         ///< hyperelastic laws: sets κ unless bulk_modulus_pa is given
@@ -63,6 +63,8 @@ struct MaterialSpec {
   double c10_pa = 0, c01_pa = 0;       ///< Mooney-Rivlin constants (Pa)
   std::vector<double> ogden_mu_pa;     ///< Ogden μ_p (Pa)
   std::vector<double> ogden_alpha;     ///< Ogden α_p
+  double cubic = 0;                    ///< biphasic springs: cubic coefficient c3 (dimensionless)
+  double critical_strain = 0;          ///< biphasic springs: critical strain εc (dimensionless)
   bool rigid = false;  ///< held in place (bone): no motion, anchors its soft neighbours
   int line = 0;
 };
@@ -100,10 +102,14 @@ struct AnchorSpec {
   int line = 0;
 };
 
-/// Rigid indenter moved at constant velocity; pushes (frictionless) the elements it touches.
+/// Rigid indenter moved at constant velocity. By default it pushes (frictionless) the elements it
+/// touches; it can also hold them on its surface (slide: bonded along the normal, free along the
+/// surface; stick: moving with it), which gives tension and shear tests.
 struct IndenterSpec {
   enum class Kind { Sphere, Plate };
+  enum class Contact { Push, Slide, Stick };
   Kind kind = Kind::Sphere;
+  Contact contact = Contact::Push;
   double radius_m = 0;               ///< sphere radius (m)
   Vec3 start_m = Vec3::Zero();       ///< sphere centre / a point on the plate at t = 0 (m)
   Vec3 normal = Vec3::UnitZ();       ///< plate: unit normal pointing from the plate into the tissue
@@ -131,6 +137,17 @@ struct OutputSpec {
   bool warped_ct = true;        ///< warped_ct.nii.gz
   bool warped_ct_dicom = true;  ///< warped_ct_dicom/ series (new UIDs, patient/study copied)
   bool fields = true;           ///< model_labels.nii.gz and per-element fields as NIfTI
+  /// surface meshes (rest and deformed .vtp, .stl, .ply) and the lattice (.vtu): docs/OUTPUTS.md
+  bool surfaces = false;
+};
+
+/// Volume preservation (docs/PHYSICS.md, "Volume preservation"): after every `every` steps the
+/// free surface elements are projected so that the volume enclosed by the surface mesh returns to
+/// its rest value, and the velocity along the volume gradient is removed.
+struct VolumeSpec {
+  bool preserve = false;  ///< off unless the scene asks
+  int every = 1;          ///< steps between corrections (≥ 1)
+  int line = 0;
 };
 
 struct Scene {
@@ -143,6 +160,7 @@ struct Scene {
   std::vector<TrackSpec> tracks;
   StopSpec stop;
   OutputSpec output;
+  VolumeSpec volume;
   std::string source_path;  ///< file the scene came from (for messages)
   std::string source_text;  ///< the scene file text, stored with results
 };

@@ -4,6 +4,7 @@
 
 #include "engine/error.hpp"
 #include "engine/loads/anchors.hpp"
+#include "engine/material/biphasic_spring.hpp"
 #include "engine/material/hyperelastic.hpp"
 
 namespace vb {
@@ -21,7 +22,7 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
     require(it != scene.materials.end(), "tissue '" + tissue + "' has no material", "materials." + tissue);
     const MaterialSpec& m = it->second;
     const std::string where = "materials." + tissue + (m.line ? " (line " + std::to_string(m.line) + ")" : "");
-    if (m.law == "linear")  // hyperelastic laws check their own parameters (law_of)
+    if (m.law == "linear" || m.law == "biphasic")  // hyperelastic laws check their own parameters (law_of)
       require(m.youngs_modulus_pa > 0 && std::isfinite(m.youngs_modulus_pa), "Young's modulus must be positive", where);
     require(m.density_kg_m3 > 0 && std::isfinite(m.density_kg_m3), "density must be positive", where);
     mass_of_tissue.push_back(m.density_kg_m3 * volume);
@@ -30,6 +31,16 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
     if (m.law == "linear" || m.rigid) {
       E_of_tissue.push_back(m.youngs_modulus_pa);
       stability_of_tissue.push_back(m.youngs_modulus_pa);
+    } else if (m.law == "biphasic") {
+      // Springs of modulus E at small strain; the time step needs the stiffest tangent, reached
+      // beyond ±εc (the dashpots keep E).
+      const BiphasicSpring spring = biphasic_spring_of(m);
+      E_of_tissue.push_back(m.youngs_modulus_pa);
+      stability_of_tissue.push_back(m.youngs_modulus_pa * spring.stiffest_tangent());
+      row[0] = 3;
+      row[9] = spring.cubic;
+      row[10] = spring.critical_strain;
+      a.biphasic = true;
     } else {
       const HyperelasticLaw law = law_of(m);
       const double mu0 = law.shear_modulus_pa();

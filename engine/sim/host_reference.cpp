@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 
 #include "engine/lattice/dual_cells.hpp"
+#include "engine/material/biphasic_spring.hpp"
 #include "engine/material/hyperelastic.hpp"
 #include "engine/material/linear_spring.hpp"
 
@@ -12,15 +13,21 @@ namespace vb {
 
 namespace {
 
-/// The law of a kernel material-table row (law 0 → none: linear springs).
+/// The law of a kernel material-table row (law 0 → none: linear springs; 3: biphasic springs).
 std::optional<HyperelasticLaw> law_of_row(const std::array<double, 12>& row) {
-  if (row[0] == 0) return std::nullopt;
+  if (row[0] == 0 || row[0] == 3) return std::nullopt;
   std::vector<double> mu, alpha;
   for (int p = 0; p < int(row[1]); ++p) {
     mu.push_back(row[2 + p]);
     alpha.push_back(row[5 + p]);
   }
   return ogden(mu, alpha, row[8]);
+}
+
+/// The biphasic spring of a material-table row (law 3: c3 in slot 9, εc in slot 10).
+std::optional<BiphasicSpring> biphasic_of_row(const std::array<double, 12>& row) {
+  if (row[0] != 3) return std::nullopt;
+  return biphasic_spring(row[9], row[10]);
 }
 
 }  // namespace
@@ -45,7 +52,10 @@ HostReference::HostReference(const Lattice& lattice, const ElementArrays& elemen
       hourglass_(scene.solver.hourglass),
       dashpot_ratio_(scene.solver.dashpot_ratio),
       integrator_(scene.solver.integrator) {
-  for (const auto& row : elements.material_table) laws_.push_back(law_of_row(row));
+  for (const auto& row : elements.material_table) {
+    laws_.push_back(law_of_row(row));
+    biphasic_.push_back(biphasic_of_row(row));
+  }
   for (std::size_t e = 0; e < lattice.element_count(); ++e) {
     neighbours_.push_back(lattice.neighbours(e));
     stiffness_.push_back(connection_stiffness(lattice, elements.youngs_modulus_pa, e));
@@ -99,9 +109,14 @@ std::vector<double> HostReference::lattice_forces(const std::vector<double>& u,
       const Vec3 r = hd + (uj - ue);
       const double len = r.norm(), rest = hd.norm();
       const Vec3 nrm = r / len;
-      // Each end adds half a spring; a hyperelastic end's rest length is its affine prediction.
-      double magnitude = hyper(e) ? hourglass_ * k * (len - (F[e] * hd).norm()) : 0.5 * k * (len - rest);
-      magnitude += hyper(j) ? hourglass_ * k * (len - (F[j] * hd).norm()) : 0.5 * k * (len - rest);
+      // Each end adds half a spring; a hyperelastic end's rest length is its affine prediction,
+      // a biphasic end pulls with ½·k·L·g(ε) of its own tissue's law.
+      const auto spring_end = [&](std::size_t a) {
+        const auto& spring = biphasic_[lattice_.tissue_of_element[a]];
+        return spring ? 0.5 * k * rest * spring->normalised_force((len - rest) / rest) : 0.5 * k * (len - rest);
+      };
+      double magnitude = hyper(e) ? hourglass_ * k * (len - (F[e] * hd).norm()) : spring_end(e);
+      magnitude += hyper(j) ? hourglass_ * k * (len - (F[j] * hd).norm()) : spring_end(j);
       if (hyper(j)) fe += Q[j] * hd;
       own_offsets += hd;
       const double inv_mass_sum = el_.inverse_mass[e] + el_.inverse_mass[j];

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "engine/lattice/lattice.hpp"
+#include "engine/material/biphasic_spring.hpp"
 #include "engine/material/hyperelastic.hpp"
 #include "engine/scene/scene.hpp"
 #include "engine/sim/element_setup.hpp"
@@ -42,6 +43,7 @@ class HostReference {
   Vec3 gravity_;
   double damping_, hourglass_, dashpot_ratio_;
   std::vector<std::optional<HyperelasticLaw>> laws_;  ///< per tissue; empty for spring tissues
+  std::vector<std::optional<BiphasicSpring>> biphasic_;  ///< per tissue; set for biphasic springs
   Integrator integrator_;
 };
 

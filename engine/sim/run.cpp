@@ -7,24 +7,73 @@
 
 #include "engine/error.hpp"
 #include "engine/results/element_measures.hpp"
+#include "engine/surface/enclosed_volume.hpp"
 
 namespace vb {
 namespace {
 
 const char* integrator_name(Integrator i) { return i == Integrator::Heun ? "heun" : "symplectic_euler"; }
 
-[[noreturn]] void report_instability(const Lattice& lattice, const Simulator& sim, const StateCheck& c,
-                                     const std::string& what) {
+/// The tissue whose free elements have the largest stability modulus per mass: the one that sets
+/// the estimated stable step (docs/PHYSICS.md, sections 3 and 8).
+const std::string& step_limiting_tissue(const Lattice& lattice, const ElementArrays& el) {
+  std::size_t stiffest = 0;
+  double highest = -1;
+  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+    const double omega_sq = el.stability_modulus_pa[e] * el.inverse_mass[e];
+    if (omega_sq > highest) highest = omega_sq, stiffest = e;
+  }
+  return lattice.tissue_names[lattice.tissue_of_element[stiffest]];
+}
+
+std::string element_name(const Lattice& lattice, std::size_t e) {
+  const auto ijk = lattice.voxel_ijk(e);
+  return "element " + std::to_string(e) + " (voxel " + std::to_string(ijk[0]) + "," + std::to_string(ijk[1]) + "," +
+         std::to_string(ijk[2]) + ") of tissue '" + lattice.tissue_names[lattice.tissue_of_element[e]] + "'";
+}
+
+/// Throws the instability error: step, time, the element (`element_role`: the fastest, or the first
+/// non-finite) with its voxel and tissue, and a step to try: dt_safety × the estimated stable limit
+/// (what "auto" would use), but at most half the step that failed, so the hint always lowers dt.
+[[noreturn]] void report_instability(const Scene& scene, const Lattice& lattice, const ElementArrays& el,
+                                     const Simulator& sim, const StateCheck& c, const std::string& what,
+                                     const std::string& element_role) {
   std::ostringstream msg;
   msg << "simulation went unstable at step " << sim.steps() << " (t = " << sim.time_s() << " s): " << what;
-  if (c.fastest_element >= 0) {
-    const auto ijk = lattice.voxel_ijk(std::size_t(c.fastest_element));
-    msg << " at element " << c.fastest_element << " (voxel " << ijk[0] << "," << ijk[1] << "," << ijk[2] << ")";
-  }
+  if (c.fastest_element >= 0) msg << element_role << element_name(lattice, std::size_t(c.fastest_element));
+  const double limit = sim.time_step().stable_limit_s;
+  double suggested = 0.5 * sim.dt_s();
+  if (limit > 0 && std::isfinite(limit)) suggested = std::min(suggested, scene.solver.dt_safety * limit);
   std::ostringstream hint;
-  hint << "use a smaller solver.dt (now " << sim.dt_s() << " s; estimated stable limit "
-       << sim.time_step().stable_limit_s << " s) or more damping";
+  hint << "use a smaller solver.dt: try solver.dt = " << suggested << " s (now " << sim.dt_s()
+       << " s; estimated stable limit " << limit << " s, set by tissue '" << step_limiting_tissue(lattice, el)
+       << "'), or more damping";
   throw Error(msg.str(), "solver", hint.str());
+}
+
+/// Throws when a hyperelastic element ends the run inverted or crushed (det F ≤ 0, from the host
+/// fit of element_measures): such a state is not a result, whatever the residual says.
+void require_no_inverted_element(const Scene& scene, const Lattice& lattice, const FinalState& st) {
+  std::vector<bool> hyperelastic;
+  for (const std::string& tissue : lattice.tissue_names) {
+    const auto it = scene.materials.find(tissue);
+    const MaterialSpec* m = it == scene.materials.end() ? nullptr : &it->second;
+    hyperelastic.push_back(m && !m->rigid &&
+                           (m->law == "neo-hookean" || m->law == "mooney-rivlin" || m->law == "ogden"));
+  }
+  std::size_t inverted = 0, worst = 0;
+  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+    if (!hyperelastic[lattice.tissue_of_element[e]] || st.volumetric_strain[e] > -1) continue;
+    if (inverted++ == 0 || st.volumetric_strain[e] < st.volumetric_strain[worst]) worst = e;
+  }
+  if (inverted == 0) return;
+  std::ostringstream msg;
+  msg << inverted << " hyperelastic element" << (inverted > 1 ? "s end" : " ends")
+      << " the run inverted or crushed (det F <= 0), the worst " << element_name(lattice, worst)
+      << " with det F = " << 1 + st.volumetric_strain[worst];
+  throw Error(msg.str(), "solver",
+              "the result is not physical; check what pushed it through its neighbours (anchors, indenter travel) "
+              "or use a smaller solver.dt");
 }
 
 }  // namespace
@@ -77,11 +126,14 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
     sim.advance(chunk);
     c = sim.check();
     if (c.nonfinite_elements > 0)
-      report_instability(lattice, sim, c, std::to_string(c.nonfinite_elements) + " elements have non-finite state");
+      report_instability(scene, lattice, el, sim, c,
+                         std::to_string(c.nonfinite_elements) + " of " + std::to_string(lattice.element_count()) +
+                             " elements have non-finite state",
+                         ", the first being ");
     if (c.max_speed_m_s * sim.dt_s() > 0.5 * h)
-      report_instability(lattice, sim, c, "an element moves more than half a spacing per step");
+      report_instability(scene, lattice, el, sim, c, "an element moves more than half a spacing per step", " at ");
     if (c.max_displacement_m > 10 * extent)
-      report_instability(lattice, sim, c, "displacement exceeds ten times the model size");
+      report_instability(scene, lattice, el, sim, c, "displacement exceeds ten times the model size", " at ");
 
     s.final_residual = c.max_residual_n / F_ref;
     s.final_speed_ratio = c.max_speed_m_s / wave_speed;
@@ -124,6 +176,10 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
     for (int k = 0; k < 3; ++k) st.position_m[3 * e + k] = X[k] + st.displacement_m[3 * e + k];
   }
   s.volume_change = compute_element_measures(lattice, el.youngs_modulus_pa, st);
+  const SurfaceMesh surface = build_surface(lattice);  // milliseconds (docs/SURFACE.md)
+  const double rest_volume = enclosed_volume_m3(surface, element_positions_m(lattice));
+  if (rest_volume != 0) s.surface_volume_change = enclosed_volume_m3(surface, st.position_m) / rest_volume - 1;
+  require_no_inverted_element(scene, lattice, st);
 
   s.elements = n;
   s.connections = lattice.connection_count;

@@ -40,6 +40,9 @@ struct RunSummary {
   double final_speed_ratio = 0;     ///< max speed / elastic wave speed (dimensionless)
   double max_displacement_m = 0;
   double volume_change = 0;         ///< (V - V0)/V0 from per-element det F (fraction)
+  /// (V − V0)/V0 of the volume enclosed by the surface mesh (docs/SURFACE.md; fraction); 0 when
+  /// the model has no closed surface. What [volume] preserve holds.
+  double surface_volume_change = 0;
   std::string device_name;
   std::string precision;            ///< "float" | "double"
   std::string integrator;           ///< "symplectic_euler" | "heun"

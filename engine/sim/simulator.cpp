@@ -1,10 +1,12 @@
 #include "engine/sim/simulator.hpp"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
 #include "engine/error.hpp"
 #include "engine/sim/kernel_tables.hpp"
+#include "engine/surface/enclosed_volume.hpp"
 
 namespace vb {
 namespace {
@@ -18,6 +20,11 @@ constexpr int kStepLattice = 4;                              // step kernels: 4 
 constexpr int kStepIndenter = kStepLattice + kLatticeArgs;   // then dt, n
 constexpr int kCheckLattice = 2;                             // check_state: u, v first
 constexpr int kCheckIndenter = kCheckLattice + kLatticeArgs; // then partial, partial_arg, n
+constexpr int kCheckVolume = kCheckIndenter + kIndenterArgs + 3;  // VB_VOLUME: grad, scalars
+// kernels/volume.cl: volume_partials takes u, v, the lattice parameters, then these.
+constexpr int kVolumeSlots = 5, kVolumeScalars = 4;
+constexpr int kVolumeMesh = 2 + kLatticeArgs;  // triangles, n_tri, surface, start, incident, n_surf
+constexpr int kVolumeCentre = kVolumeMesh + 6, kVolumeWithForce = kVolumeMesh + 8;
 
 template <typename T>
 std::vector<T> pack4(const std::vector<double>& xyz, const std::vector<double>* w) {
@@ -46,6 +53,16 @@ std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Prec
   const std::size_t real = precision == Precision::Double ? 8 : 4;
   const std::size_t hyper = hyperelastic ? 2 * 3 * 4 * real + 1 : 0;  // F and Q rows, tissue id
   return elements * (4 * 4 * real + real + 4 + hyper) + cells * 4;
+}
+
+std::size_t estimated_volume_device_bytes(std::size_t elements, std::size_t surface_elements, std::size_t triangles,
+                                          Precision precision) {
+  const std::size_t real = precision == Precision::Double ? 8 : 4;
+  const std::size_t groups = (std::max(surface_elements, triangles) + kCheckWorkGroup - 1) / kCheckWorkGroup;
+  return triangles * 3 * 4                       // triangle corners (element ids)
+         + surface_elements * 4 + (surface_elements + 1) * 4 + triangles * 3 * 4  // CSR of incident corners
+         + elements * 4 * real                   // gradient per element
+         + (groups * kVolumeSlots + kVolumeScalars) * real;
 }
 
 namespace {
@@ -85,6 +102,15 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
 
   const std::size_t state_bytes = 4 * real_size_ * n_;
   device_bytes_ = estimated_device_bytes(n_, cells, precision_, el.hyperelastic);
+  volume_ = scene.volume.preserve;
+  require(!volume_ || scene.volume.every >= 1, "volume.every must be at least 1", "volume.every");
+  SurfaceMesh mesh;
+  if (volume_) {
+    mesh = build_surface(lattice);
+    require(!mesh.triangles.empty(), "the model has no closed surface to preserve the volume of", "volume.preserve",
+            "the body is the union of complete dual cells (docs/SURFACE.md): it needs parts two elements thick");
+    device_bytes_ += estimated_volume_device_bytes(n_, mesh.surface_element_count, mesh.triangles.size(), precision_);
+  }
   require(double(device_bytes_) < 0.9 * double(cl.info.global_memory_bytes) &&
               std::max((el.hyperelastic ? 3 : 1) * state_bytes, cells * sizeof(cl_int)) <= cl.info.max_allocation_bytes,
           "the model needs " + mib(double(device_bytes_)) + " of device memory but '" + cl.info.name +
@@ -129,9 +155,13 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_CHECK_SLOTS=" + std::to_string(check_slots_);
   options += " -DVB_RSQRT=" + std::to_string(cl.info.is_gpu);
   options += " -DVB_HYPER=" + std::to_string(el.hyperelastic);
+  options += " -DVB_BIPHASIC=" + std::to_string(el.biphasic);
   options += " -DVB_CHECK_WG=" + std::to_string(kCheckWorkGroup);
-  program_ = build_program(cl, {"common.cl", "hyperelastic.cl", "lattice_forces.cl", "integrate.cl", "checks.cl"},
-                           lattice_tables_source(), options);
+  options += " -DVB_VOLUME=" + std::to_string(volume_);
+  std::vector<std::string> sources = {"common.cl", "hyperelastic.cl", "lattice_forces.cl", "integrate.cl"};
+  if (volume_) sources.push_back("volume.cl");
+  sources.push_back("checks.cl");
+  program_ = build_program(cl, sources, lattice_tables_source(), options);
   if (hyper_) {
     stress_ = cl::Kernel(program_, "element_stress");
     stress_.setArg(1, tissue_);
@@ -170,18 +200,133 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   check_.setArg(kCheckIndenter + kIndenterArgs, partial_);
   check_.setArg(kCheckIndenter + kIndenterArgs + 1, partial_arg_);
   check_.setArg(kCheckIndenter + kIndenterArgs + 2, cl_uint(n_));
+  if (volume_) make_volume_buffers(mesh);
+}
+
+void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
+  // Triangles as element ids; per surface element the corners (3·triangle + corner) it is in,
+  // over all its vertices (an element on a pinch has several).
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  std::vector<std::uint32_t> surface_index(n_, kNone);
+  std::vector<cl_uint> surface;
+  for (const std::uint32_t e : mesh.element_of_vertex)
+    if (surface_index[e] == kNone) surface_index[e] = std::uint32_t(surface.size()), surface.push_back(e);
+  std::vector<cl_uint> triangles(3 * mesh.triangles.size()), start(surface.size() + 1, 0), incident;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      triangles[3 * t + c] = mesh.element_of_vertex[mesh.triangles[t][c]];
+      ++start[surface_index[triangles[3 * t + c]] + 1];
+    }
+  for (std::size_t i = 0; i < surface.size(); ++i) start[i + 1] += start[i];
+  incident.resize(start.back());
+  std::vector<cl_uint> fill(start.begin(), start.end() - 1);
+  for (std::size_t k = 0; k < triangles.size(); ++k) incident[fill[surface_index[triangles[k]]]++] = cl_uint(k);
+
+  volume_triangles_ = mesh.triangles.size();
+  volume_surface_ = surface.size();
+  volume_groups_ = (std::max(volume_triangles_, volume_surface_) + kCheckWorkGroup - 1) / kCheckWorkGroup;
+  frame_sign_ = lattice_.rotation.determinant() < 0 ? -1.0 : 1.0;
+  rest_volume_m3_ = double(mesh.complete_cell_count) * std::pow(lattice_.spacing_m, 3);
+  Vec3 centre = Vec3::Zero();  // positions are taken relative to it, to keep rounding small
+  for (const cl_uint e : surface) centre += lattice_.rest_position(e);
+  centre /= double(surface.size());
+
+  const auto flags_ro = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
+  vol_triangles_ = cl::Buffer(cl_.context, flags_ro, triangles.size() * sizeof(cl_uint), triangles.data());
+  vol_surface_ = cl::Buffer(cl_.context, flags_ro, surface.size() * sizeof(cl_uint), surface.data());
+  vol_incident_start_ = cl::Buffer(cl_.context, flags_ro, start.size() * sizeof(cl_uint), start.data());
+  vol_incident_ = cl::Buffer(cl_.context, flags_ro, incident.size() * sizeof(cl_uint), incident.data());
+  std::vector<char> zeros(4 * real_size_ * n_, 0);  // gradient: zero off the surface
+  vol_grad_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, zeros.size(), zeros.data());
+  vol_partial_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, volume_groups_ * kVolumeSlots * real_size_);
+  std::vector<char> scalar_zeros(kVolumeScalars * real_size_, 0);
+  vol_scalars_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, scalar_zeros.size(),
+                            scalar_zeros.data());
+
+  vol_partials_ = cl::Kernel(program_, "volume_partials");
+  set_lattice_args(vol_partials_, 2);
+  vol_partials_.setArg(kVolumeMesh + 0, vol_triangles_);
+  vol_partials_.setArg(kVolumeMesh + 1, cl_uint(volume_triangles_));
+  vol_partials_.setArg(kVolumeMesh + 2, vol_surface_);
+  vol_partials_.setArg(kVolumeMesh + 3, vol_incident_start_);
+  vol_partials_.setArg(kVolumeMesh + 4, vol_incident_);
+  vol_partials_.setArg(kVolumeMesh + 5, cl_uint(volume_surface_));
+  set_world_vector(vol_partials_, kVolumeCentre, centre);
+  vol_partials_.setArg(kVolumeCentre + 1, vol_grad_);
+  vol_partials_.setArg(kVolumeWithForce + 1, vol_partial_);
+  vol_finish_ = cl::Kernel(program_, "volume_finish");
+  vol_finish_.setArg(0, vol_partial_);
+  vol_finish_.setArg(1, cl_uint(volume_groups_));
+  set_real(vol_finish_, 2, frame_sign_ * rest_volume_m3_);  // lattice frame
+  vol_finish_.setArg(3, vol_scalars_);
+  vol_apply_ = cl::Kernel(program_, "volume_apply");
+  vol_apply_.setArg(2, vol_surface_);
+  vol_apply_.setArg(3, cl_uint(volume_surface_));
+  vol_apply_.setArg(4, vol_grad_);
+  vol_apply_.setArg(5, vol_scalars_);
+  check_.setArg(kCheckVolume, vol_grad_);
+  check_.setArg(kCheckVolume + 1, vol_scalars_);
+}
+
+void Simulator::enqueue_volume_sums(bool with_force) { enqueue_volume_sums(with_force, u_, v_); }
+
+void Simulator::enqueue_volume_sums(bool with_force, const cl::Buffer& u, const cl::Buffer& v) {
+  vol_partials_.setArg(0, u);
+  vol_partials_.setArg(1, v);
+  vol_partials_.setArg(kVolumeWithForce, cl_int(with_force));
+  const cl::NDRange wg(kCheckWorkGroup);
+  cl_.queue.enqueueNDRangeKernel(vol_partials_, cl::NullRange, cl::NDRange(volume_groups_ * kCheckWorkGroup), wg);
+  cl_.queue.enqueueNDRangeKernel(vol_finish_, cl::NullRange, wg, wg);
+}
+
+void Simulator::enqueue_volume_correction(const cl::Buffer& u, const cl::Buffer& v) {
+  enqueue_volume_sums(false, u, v);
+  vol_apply_.setArg(0, u);
+  vol_apply_.setArg(1, v);
+  const std::size_t wg = kCheckWorkGroup, global = (volume_surface_ + wg - 1) / wg * wg;
+  cl_.queue.enqueueNDRangeKernel(vol_apply_, cl::NullRange, cl::NDRange(global),
+                                 cl_.info.is_gpu ? cl::NDRange(wg) : cl::NullRange);
+}
+
+double Simulator::enclosed_volume_m3() {
+  require(volume_, "the enclosed volume is computed on the device only with [volume] preserve = true");
+  enqueue_volume_sums(false);
+  return read_enclosed_volume_m3();
+}
+
+double Simulator::read_enclosed_volume_m3() const {
+  std::vector<double> scalars(kVolumeScalars);  // λ, μ, V, p (kernels/volume.cl)
+  if (precision_ == Precision::Double) {
+    cl_.queue.enqueueReadBuffer(vol_scalars_, CL_TRUE, 0, scalars.size() * sizeof(double), scalars.data());
+  } else {
+    std::vector<float> f(kVolumeScalars);
+    cl_.queue.enqueueReadBuffer(vol_scalars_, CL_TRUE, 0, f.size() * sizeof(float), f.data());
+    std::copy(f.begin(), f.end(), scalars.begin());
+  }
+  return frame_sign_ * scalars[2];
+}
+
+std::vector<double> Simulator::volume_gradient_m2() {
+  require(volume_, "the volume gradient is computed on the device only with [volume] preserve = true");
+  enqueue_volume_sums(false);
+  std::vector<double> g;
+  if (precision_ == Precision::Double) read_xyz<double>(vol_grad_, g); else read_xyz<float>(vol_grad_, g);
+  for (double& x : g) x *= frame_sign_;
+  return g;
 }
 
 void Simulator::make_hyperelastic_buffers(const ElementArrays& el) {
   // Only scenes with hyperelastic tissues get real buffers; others get 1-element placeholders.
+  // Biphasic springs need the tissue ids and the material table too (not F and Q).
   hyper_ = el.hyperelastic;
+  const bool per_tissue = hyper_ || el.biphasic;
   const auto flags_ro = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
-  std::vector<cl_uchar> tissue(hyper_ ? n_ : 1, 0);
-  if (hyper_) std::copy(lattice_.tissue_of_element.begin(), lattice_.tissue_of_element.end(), tissue.begin());
+  std::vector<cl_uchar> tissue(per_tissue ? n_ : 1, 0);
+  if (per_tissue) std::copy(lattice_.tissue_of_element.begin(), lattice_.tissue_of_element.end(), tissue.begin());
   tissue_ = cl::Buffer(cl_.context, flags_ro, tissue.size(), tissue.data());
   std::vector<double> table;
   for (const auto& row : el.material_table) table.insert(table.end(), row.begin(), row.end());
-  if (!hyper_) table.assign(12, 0.0);
+  if (!per_tissue) table.assign(12, 0.0);
   materials_ = make_real_buffer(table);
   const std::size_t matrix_bytes = (hyper_ ? 3 * n_ : 1) * 4 * real_size_;  // 3 rows of real4
   Q_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, matrix_bytes);
@@ -253,6 +398,7 @@ std::vector<double> Simulator::indenter_table() const {
     for (int c = 0; c < 3; ++c) row[c] = start[c], row[4 + c] = normal[c], row[8 + c] = velocity[c];
     row[3] = ind.kind == IndenterSpec::Kind::Plate ? -1.0 : ind.radius_m;
     row[12] = std::isfinite(ind.travel_time_s) ? ind.travel_time_s : 1e300;
+    row[13] = double(int(ind.contact));  // 0 push, 1 slide, 2 stick
   }
   return table;
 }
@@ -286,8 +432,12 @@ void Simulator::advance(std::int64_t steps) {
         set_indenter_args(predict_, kStepIndenter, t0, t1);
         set_indenter_args(correct_, kStepIndenter, t1, t1);
       }
+      const bool project = volume_ && (steps_ + 1) % scene_.volume.every == 0;
       enqueue_stress(u_);
       enqueue(predict_);
+      // The predicted stage is projected too: its velocity along g would otherwise reach the
+      // corrector's dashpots and leave a steady slip at the constrained equilibrium.
+      if (project) enqueue_volume_correction(u_tmp_, v_tmp_);
       enqueue_stress(u_tmp_);
       enqueue(correct_);
     } else {
@@ -298,6 +448,7 @@ void Simulator::advance(std::int64_t steps) {
       std::swap(u_, u_tmp_);
       std::swap(v_, v_tmp_);
     }
+    if (volume_ && (steps_ + 1) % scene_.volume.every == 0) enqueue_volume_correction(u_, v_);
   }
   cl_.queue.flush();
 }
@@ -307,6 +458,7 @@ StateCheck Simulator::check() {
   check_.setArg(1, v_);
   set_indenter_args(check_, kCheckIndenter, time_s(), time_s());
   enqueue_stress(u_);
+  if (volume_) enqueue_volume_sums(true);  // the pressure the residual leaves out
   enqueue_check();
   std::vector<double> p(check_groups_ * check_slots_);
   if (precision_ == Precision::Double) {
@@ -338,6 +490,7 @@ StateCheck Simulator::check() {
       c.contact_elements[i] += std::llround(r[3]);
     }
   }
+  if (volume_) c.enclosed_volume_m3 = read_enclosed_volume_m3();
   return c;
 }
 

@@ -10,6 +10,7 @@
 #include "engine/sim/element_setup.hpp"
 #include "engine/sim/opencl_runtime.hpp"
 #include "engine/sim/time_step.hpp"
+#include "engine/surface/surface_mesh.hpp"
 
 namespace vb {
 
@@ -23,12 +24,18 @@ struct StateCheck {
   std::vector<std::int64_t> contact_elements;   ///< per indenter: elements touching it
   std::int64_t nonfinite_elements = 0;
   std::int64_t fastest_element = -1;  ///< element with the largest speed (or first non-finite)
+  /// [volume] preserve only: volume enclosed by the surface (m³, world frame); else 0
+  double enclosed_volume_m3 = 0;
 };
 
 /// Device bytes a model of `elements` elements in a padded grid of `cells` voxels needs
 /// (hyperelastic models also store F and Q per element).
 std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision,
                                    bool hyperelastic = false);
+/// Extra device bytes of the volume constraint (kernels/volume.cl): triangles, the per-surface-
+/// element CSR of incident triangle corners, the gradient (per element) and the partial sums.
+std::size_t estimated_volume_device_bytes(std::size_t elements, std::size_t surface_elements,
+                                          std::size_t triangles, Precision precision);
 
 class Simulator {
  public:
@@ -46,6 +53,12 @@ class Simulator {
   void upload(const std::vector<double>& u_m, const std::vector<double>& v_m_s);
   /// Lattice spring + dashpot forces at the current state (n×3, N, world frame); for tests.
   std::vector<double> lattice_forces();
+  /// [volume] preserve only: the device's enclosed volume (m³) and its gradient (n×3, m²; zero
+  /// off the surface) at the current state, world frame; for tests.
+  double enclosed_volume_m3();
+  std::vector<double> volume_gradient_m2();
+  /// volume of the surface at rest (m³, world frame); 0 without [volume] preserve
+  double rest_volume_m3() const { return rest_volume_m3_; }
 
   double dt_s() const { return dt_.dt_s; }
   const TimeStepChoice& time_step() const { return dt_; }
@@ -99,6 +112,22 @@ class Simulator {
   cl::Program program_;
   cl::Kernel euler_, predict_, correct_;
   mutable cl::Kernel check_;
+
+  // Volume constraint ([volume] preserve): the surface mesh, uploaded once.
+  void make_volume_buffers(const SurfaceMesh& mesh);
+  /// enqueues the partial sums (with the residual pressure when with_force) and λ, μ, V, p
+  void enqueue_volume_sums(bool with_force);
+  void enqueue_volume_sums(bool with_force, const cl::Buffer& u, const cl::Buffer& v);
+  /// projects the state (u, v) onto V = V0 and removes its velocity along g
+  void enqueue_volume_correction(const cl::Buffer& u, const cl::Buffer& v);
+  /// V (m³, world frame) from the last volume_finish
+  double read_enclosed_volume_m3() const;
+  bool volume_ = false;
+  double rest_volume_m3_ = 0, frame_sign_ = 1;  ///< det(rotation): lattice-frame V = sign·V_world
+  std::size_t volume_triangles_ = 0, volume_surface_ = 0, volume_groups_ = 0;
+  cl::Buffer vol_triangles_, vol_surface_, vol_incident_start_, vol_incident_, vol_grad_, vol_partial_,
+      vol_scalars_;
+  cl::Kernel vol_partials_, vol_finish_, vol_apply_;
 };
 
 }  // namespace vb

@@ -27,8 +27,13 @@ t = s["tracked"]["tumour_centre"]["displacement_m"]
 nipple = s["tracked"]["nipple"]["displacement_m"]
 assert t[1] < -0.0005, t  # prone: the tumour moves anteriorly (−y, away from the chest wall)
 assert nipple[1] < t[1], (nipple, t)  # tissue far from the chest wall moves more
+m = s["mesh_outputs"]  # the sample asks for output.surfaces
+assert m["surface_triangles"] > 2 * 1000 and m["surface_vertices"] > 1000, m
+import os
+for f in m["files"]:
+    assert os.path.getsize(os.path.join(os.path.dirname(sys.argv[1]), f)) > 1000, f
 PY
-then pass "sample scene converges, tumour moves anteriorly, outputs written"
+then pass "sample scene converges, tumour moves anteriorly, outputs and meshes written"
 else fail "sample scene"; cat "$work/sample.txt"; fi
 h5dump -H "$work/sample/result.h5" >"$work/h5.txt" 2>&1
 if grep -q '"displacement_m"' "$work/h5.txt"; then pass "result.h5 readable"; else fail "result.h5"; fi

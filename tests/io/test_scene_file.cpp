@@ -142,6 +142,7 @@ travel_time = 10
 kind = "plate"
 start = [0, 0, -0.001]
 normal = [0, 0, 1]
+contact = "slide"
 
 [[track]]
 name = "apex"
@@ -228,6 +229,8 @@ TEST(SceneFile, FullSceneParsesToExpectedValues) {
   EXPECT_EQ(s.indenters[1].kind, IndenterSpec::Kind::Plate);
   expect_vec(s.indenters[1].velocity_m_s, 0, 0, 0);
   EXPECT_TRUE(std::isinf(s.indenters[1].travel_time_s));
+  EXPECT_EQ(s.indenters[0].contact, IndenterSpec::Contact::Push) << "the default";
+  EXPECT_EQ(s.indenters[1].contact, IndenterSpec::Contact::Slide);
 
   ASSERT_EQ(s.tracks.size(), 2u);
   EXPECT_EQ(s.tracks[1].name, "lateral");
@@ -249,7 +252,17 @@ TEST(SceneFile, AbsentSectionsKeepDefaults) {
   EXPECT_FALSE(s.solver.dt_s.has_value());
   EXPECT_EQ(s.stop.max_steps, defaults.stop.max_steps);
   EXPECT_EQ(s.model.downsample, 1);
+  EXPECT_FALSE(s.volume.preserve);
+  EXPECT_EQ(s.volume.every, 1);
   EXPECT_TRUE(s.source_path.empty());
+}
+
+TEST(SceneFile, VolumeSectionParses) {
+  const Scene s = parse_scene_text(kBase + "[volume]\npreserve = true\nevery = 4\n", "scene.toml");
+  EXPECT_TRUE(s.volume.preserve);
+  EXPECT_EQ(s.volume.every, 4);
+  EXPECT_EQ(s.volume.line, 10);
+  EXPECT_FALSE(parse_scene_text(kBase + "[volume]\npreserve = false\n", "scene.toml").volume.preserve);
 }
 
 TEST(SceneFile, DtAutoAndGravityVector) {
@@ -268,6 +281,24 @@ TEST(SceneFile, ReadsFileAndRecordsPath) {
   std::filesystem::remove(path);
   EXPECT_EQ(s.source_path, path.string());
   EXPECT_EQ(s.source_text, kBase);
+}
+
+TEST(SceneFile, BiphasicSpringKeysParse) {
+  const Scene s = parse_scene_text(
+      with("E = 3000.0", "law = \"biphasic\"\nE = 3000.0\ncubic = 20\ncritical_strain = 0.1"), "scene.toml");
+  const MaterialSpec& m = s.materials.at("adipose");
+  EXPECT_EQ(m.law, "biphasic");
+  EXPECT_DOUBLE_EQ(m.youngs_modulus_pa, 3000);
+  EXPECT_DOUBLE_EQ(m.cubic, 20);  // integer accepted
+  EXPECT_DOUBLE_EQ(m.critical_strain, 0.1);
+  // "biphasic_spring" names the same law; a default tissue keeps its E; c3 = 0 is allowed.
+  const Scene alias = parse_scene_text(
+      with("E = 3000.0", "law = \"biphasic_spring\"\ncubic = 0\ncritical_strain = 0.25"), "scene.toml");
+  const MaterialSpec& a = alias.materials.at("adipose");
+  EXPECT_EQ(a.law, "biphasic");
+  EXPECT_GT(a.youngs_modulus_pa, 0);
+  EXPECT_DOUBLE_EQ(a.cubic, 0);
+  EXPECT_DOUBLE_EQ(a.critical_strain, 0.25);
 }
 
 TEST(SceneFile, MissingFileErrorNamesPath) {
@@ -353,8 +384,24 @@ std::vector<ErrorCase> error_cases() {
        {"unknown posture 'sideways'", "supine, prone, upright, left_lateral, right_lateral"}},
       {"MagnitudeWithVector", kBase + "[gravity]\nvector = [0, 0, -9.81]\nmagnitude = 3.0\n",
        "gravity.magnitude", 12, {"only with 'posture'"}},
-      {"LawNotAvailable", with("E = 3000.0", "law = \"biphasic_spring\"\nE = 3000.0"),
-       "materials.adipose.law", 9, {"not available in this version"}},
+      {"BiphasicWithoutCubic", with("E = 3000.0", "law = \"biphasic\"\nE = 3000.0\ncritical_strain = 0.1"),
+       "materials.adipose.cubic", 8, {"missing required key"}},
+      {"BiphasicWithoutCriticalStrain", with("E = 3000.0", "law = \"biphasic\"\nE = 3000.0\ncubic = 20.0"),
+       "materials.adipose.critical_strain", 8, {"missing required key"}},
+      {"BiphasicNegativeCubic", with("E = 3000.0", "law = \"biphasic\"\nE = 3000.0\ncubic = -1.0\ncritical_strain = 0.1"),
+       "materials.adipose.cubic", 11, {"≥ 0"}},
+      {"BiphasicCriticalStrainOne", with("E = 3000.0", "law = \"biphasic\"\nE = 3000.0\ncubic = 20.0\ncritical_strain = 1.0"),
+       "materials.adipose.critical_strain", 12, {"(0, 1)"}},
+      {"BiphasicCriticalStrainZero", with("E = 3000.0", "law = \"biphasic\"\ncubic = 20.0\ncritical_strain = 0"),
+       "materials.adipose.critical_strain", 11, {"(0, 1)"}},
+      {"BiphasicCriticalStrainNotANumber", with("E = 3000.0", "law = \"biphasic\"\ncubic = 20.0\ncritical_strain = \"10%\""),
+       "materials.adipose.critical_strain", 11, {"expected a number"}},
+      {"CubicOnLinear", with("E = 3000.0", "E = 3000.0\ncubic = 20.0"), "materials.adipose.cubic", 10,
+       {"does not apply to law 'linear'", "keys for this law: E"}},
+      {"CriticalStrainOnNeoHookean", with("E = 3000.0", "law = \"neo-hookean\"\nE = 3000.0\ncritical_strain = 0.1"),
+       "materials.adipose.critical_strain", 11, {"does not apply to law 'neo-hookean'"}},
+      {"NuOnBiphasic", with("E = 3000.0", "law = \"biphasic\"\ncubic = 20.0\ncritical_strain = 0.1\nnu = 0.45"),
+       "materials.adipose.nu", 12, {"Poisson ratio 0.25"}},
       {"KeyOfAnotherLaw", with("E = 3000.0", "law = \"neo-hookean\"\nE = 3000.0\nalpha = [2.0]"),
        "materials.adipose.alpha", 11, {"does not apply to law 'neo-hookean'"}},
       {"PoissonRatioAtHalf", with("E = 3000.0", "law = \"neo-hookean\"\nE = 3000.0\nnu = 0.5"),
@@ -379,12 +426,23 @@ std::vector<ErrorCase> error_cases() {
        "anchor.base.normal", 13, {"nonzero"}},
       {"IndenterWithoutStart", kBase + "[[indenter]]\nkind = \"sphere\"\nradius = 0.005\n",
        "indenter[0].start", 10, {"missing required key"}},
+      {"UnknownContact",
+       kBase + "[[indenter]]\nkind = \"plate\"\nstart = [0, 0, 0]\nnormal = [0, 0, 1]\ncontact = \"stik\"\n",
+       "indenter[0].contact", 14, {"unknown value 'stik'", "did you mean 'stick'?"}},
       {"DuplicateTrackName", kBase + track + track, "track[1].name", 14,
        {"duplicate track name 'apex'", "line 10"}},
       {"OutputDvfNeedsImage", kBase + "[output]\ndvf = true\n", "output.dvf", 11,
        {"needs a CT image model"}},
-      {"VolumeNotSupported", kBase + "[volume]\npreserve = true\n", "volume", 10,
+      {"DeviceNotSupported", kBase + "[device]\nkind = \"torus\"\n", "device", 10,
        {"not supported yet"}},
+      {"VolumeUnknownKey", kBase + "[volume]\npreserve = true\nstiffness = 1.0\n", "volume.stiffness", 12,
+       {"unknown key"}},
+      {"VolumePreserveNotBool", kBase + "[volume]\npreserve = 1\n", "volume.preserve", 11,
+       {"true or false"}},
+      {"VolumeEveryZero", kBase + "[volume]\npreserve = true\nevery = 0\n", "volume.every", 12,
+       {"integer ≥ 1"}},
+      {"VolumeEveryFloat", kBase + "[volume]\nevery = 2.0\n", "volume.every", 11,
+       {"expected an integer"}},
       {"TomlSyntaxError", kBase + "[solver\n", "", 10, {"TOML syntax error", "scene.toml:10:"}},
   };
 }

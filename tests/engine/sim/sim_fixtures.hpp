@@ -1,6 +1,8 @@
 #pragma once
 // Helpers for simulator tests: scenes built in code and one OpenCL context per test binary.
+#include <cmath>
 #include <memory>
+#include <vector>
 
 #include "engine/lattice/voxelise.hpp"
 #include "engine/scene/scene.hpp"
@@ -45,6 +47,39 @@ inline AnchorSpec halfspace_anchor(const std::string& name, const Vec3& point, c
   a.point_m = point;
   a.normal = normal;
   return a;
+}
+
+/// The hyperelastic validation tissues: neo-Hookean (E = 3 kPa) or, for law "ogden", two-term
+/// Ogden (μ = 1200, −300 Pa; α = 4, −2); named "soft", ρ = 1000 kg/m³.
+inline MaterialSpec validation_material(const std::string& law, double nu) {
+  MaterialSpec m = material("soft", 3000, 1000);
+  if (law == "ogden") {
+    m.law = "ogden";
+    m.ogden_mu_pa = {1200, -300};
+    m.ogden_alpha = {4, -2};
+  } else {
+    m.law = "neo-hookean";
+  }
+  m.poisson_ratio = nu;
+  return m;
+}
+
+/// Two plates through the centres of the bottom and top layers of an n-layer box of spacing h
+/// (so the gap is (n − 1)·h); the top one moves by (stretch − 1)·gap along z at `speed` and stops.
+inline std::vector<IndenterSpec> plate_pair(int n, double h, double stretch,
+                                            IndenterSpec::Contact contact = IndenterSpec::Contact::Push,
+                                            double speed = 0.05) {
+  const double gap = (n - 1) * h, travel = (stretch - 1) * gap;
+  IndenterSpec base, top;
+  base.kind = top.kind = IndenterSpec::Kind::Plate;
+  base.contact = top.contact = contact;
+  base.start_m = Vec3(0, 0, 0.5 * h);
+  base.normal = Vec3(0, 0, 1);
+  top.start_m = Vec3(0, 0, 0.5 * h + gap);
+  top.normal = Vec3(0, 0, -1);
+  top.velocity_m_s = Vec3(0, 0, travel > 0 ? speed : -speed);
+  top.travel_time_s = std::abs(travel) / speed;
+  return {base, top};
 }
 
 struct Model {

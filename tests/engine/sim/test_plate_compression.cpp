@@ -17,19 +17,6 @@ struct Level {
   double stretch;
 };
 
-MaterialSpec material_for(const std::string& law) {
-  MaterialSpec m = test::material("soft", 3000, 1000);
-  if (law == "ogden") {
-    m.law = "ogden";
-    m.ogden_mu_pa = {1200, -300};
-    m.ogden_alpha = {4, -2};
-  } else {
-    m.law = "neo-hookean";
-  }
-  m.poisson_ratio = 0.495;
-  return m;
-}
-
 class PlateCompression : public ::testing::TestWithParam<Level> {};
 
 TEST_P(PlateCompression, NominalStressMatchesClosedForm) {
@@ -37,18 +24,8 @@ TEST_P(PlateCompression, NominalStressMatchesClosedForm) {
   const int n = 10;
   const double h = 0.002, span = (n - 1) * h;  // plates touch the outer layers' centres
   Scene s = test::box_scene(n, n, n, h);
-  s.materials["soft"] = material_for(c.law);
-  s.materials["soft"].name = "soft";
-  const double bottom = 0.5 * h, top = bottom + span, travel = (1 - c.stretch) * span;
-  IndenterSpec base, press;
-  base.kind = press.kind = IndenterSpec::Kind::Plate;
-  base.start_m = Vec3(0, 0, bottom);
-  base.normal = Vec3(0, 0, 1);
-  press.start_m = Vec3(0, 0, top);
-  press.normal = Vec3(0, 0, -1);
-  press.velocity_m_s = Vec3(0, 0, -0.05);
-  press.travel_time_s = travel / 0.05;
-  s.indenters = {base, press};
+  s.materials["soft"] = test::validation_material(c.law, 0.495);
+  s.indenters = test::plate_pair(n, h, c.stretch);
   // Hold the cube's centre column in x and y only through symmetry: the plates are frictionless, so
   // nothing else stops a drift; a drift does not change the forces.
   s.solver.precision = Precision::Double;

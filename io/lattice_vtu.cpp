@@ -1,0 +1,64 @@
+#include "io/lattice_vtu.hpp"
+
+#include <Eigen/LU>
+
+#include "engine/error.hpp"
+#include "engine/surface/surface_elements.hpp"
+#include "io/atomic_file.hpp"
+#include "io/vtk_xml_arrays.hpp"
+
+namespace vb {
+
+void write_lattice_vtu(const std::string& path, const Lattice& lattice, std::span<const double> positions_m,
+                       std::span<const double> displacement_m, const std::vector<ElementField>& fields) {
+  const std::size_t n = lattice.element_count();
+  require(positions_m.size() == 3 * n, "positions must be n_elements × 3", path);
+  require(displacement_m.empty() || displacement_m.size() == 3 * n, "displacement must be n_elements × 3", path);
+  for (const ElementField& f : fields)
+    require(f.components >= 1 && f.values.size() == n * std::size_t(f.components),
+            "field '" + f.name + "' must have n_elements × " + std::to_string(f.components) + " values", path);
+
+  std::vector<double> points(3 * n), displacement(3 * n, 0.0);
+  std::vector<std::int32_t> tissue(n);
+  for (std::size_t i = 0; i < 3 * n; ++i) {
+    points[i] = 1000.0 * positions_m[i];
+    if (!displacement_m.empty()) displacement[i] = 1000.0 * displacement_m[i];
+  }
+  for (std::size_t e = 0; e < n; ++e) tissue[e] = lattice.tissue_of_element[e];
+
+  // Each complete cell from its corner with the lowest coordinates. VTK's hexahedron order is
+  // the bottom face counter-clockwise seen from the top, then the top face; in a left-handed
+  // world frame the two faces swap so that the cell keeps a positive volume.
+  const std::vector<std::uint8_t> octants = complete_octants_of_elements(lattice);
+  const bool mirrored = lattice.rotation.determinant() < 0;
+  const std::size_t sx = 1, sy = std::size_t(lattice.dims[0]), sz = sy * std::size_t(lattice.dims[1]);
+  const std::size_t corner_offset[8] = {0, sx, sx + sy, sy, sz, sx + sz, sx + sy + sz, sy + sz};
+  std::vector<std::int64_t> connectivity, offsets;
+  for (std::size_t e = 0; e < n; ++e) {
+    if (!(octants[e] >> 7)) continue;
+    const std::size_t v = lattice.voxel_of_element[e];
+    for (int k = 0; k < 8; ++k) {
+      const int corner = mirrored ? (k + 4) % 8 : k;
+      connectivity.push_back(lattice.element_of_voxel[v + corner_offset[corner]]);
+    }
+    offsets.push_back(std::int64_t(connectivity.size()));
+  }
+  const std::vector<std::uint8_t> types(offsets.size(), 12);  // VTK_HEXAHEDRON
+
+  using vtk_xml::data_array;
+  std::string xml =
+      "<?xml version=\"1.0\"?>\n"
+      "<!-- VoxBreast lattice: elements as points, complete dual cells as hexahedra; DICOM LPS, mm -->\n"
+      "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+      "<UnstructuredGrid>\n" +
+      vtk_xml::field_data(lattice.tissue_names) + "<Piece NumberOfPoints=\"" + std::to_string(n) +
+      "\" NumberOfCells=\"" + std::to_string(offsets.size()) + "\">\n<PointData Vectors=\"displacement_mm\">\n" +
+      data_array("displacement_mm", 3, displacement) + data_array("tissue", 1, tissue);
+  for (const ElementField& f : fields) xml += data_array(f.name, f.components, std::vector<double>(f.values.begin(), f.values.end()));
+  xml += "</PointData>\n<Points>\n" + data_array("", 3, points) + "</Points>\n<Cells>\n" +
+         data_array("connectivity", 1, connectivity) + data_array("offsets", 1, offsets) +
+         data_array("types", 1, types) + "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+  write_text_atomically(path, xml);
+}
+
+}  // namespace vb
