@@ -19,6 +19,17 @@ inline real4 element_position(uint e, global const real4* u, global const uint* 
   return rest_position(cell_of[e], sy, sz, origin, h) + xyz0(u[e]) - centre;
 }
 
+// Sums each slot of `value` over the work-group into s[k][0] (every work-item must call it).
+inline void sum_over_group(local real (*s)[VB_CHECK_WG], const real* value, uint l) {
+  for (int k = 0; k < VB_VOLUME_SLOTS; ++k) s[k][l] = value[k];
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint stride = VB_CHECK_WG / 2; stride > 0; stride /= 2) {
+    if (l < stride)
+      for (int k = 0; k < VB_VOLUME_SLOTS; ++k) s[k][l] += s[k][l + stride];
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+}
+
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
 void volume_partials(global const real4* u, global const real4* v, VB_LATTICE_PARAMS,
                      global const uint* triangles, uint n_triangles,
@@ -56,13 +67,7 @@ void volume_partials(global const real4* u, global const real4* v, VB_LATTICE_PA
       value[4] = dot3(g, f);
     }
   }
-  for (int k = 0; k < VB_VOLUME_SLOTS; ++k) s[k][l] = value[k];
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (uint stride = VB_CHECK_WG / 2; stride > 0; stride /= 2) {
-    if (l < stride)
-      for (int k = 0; k < VB_VOLUME_SLOTS; ++k) s[k][l] += s[k][l + stride];
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
+  sum_over_group(s, value, l);
   if (l == 0)
     for (int k = 0; k < VB_VOLUME_SLOTS; ++k) partial[get_group_id(0) * VB_VOLUME_SLOTS + k] = s[k][0];
 }
@@ -75,13 +80,7 @@ void volume_finish(global const real* partial, uint groups, real rest_volume, gl
   for (int k = 0; k < VB_VOLUME_SLOTS; ++k) value[k] = 0;
   for (uint g = l; g < groups; g += VB_CHECK_WG)
     for (int k = 0; k < VB_VOLUME_SLOTS; ++k) value[k] += partial[g * VB_VOLUME_SLOTS + k];
-  for (int k = 0; k < VB_VOLUME_SLOTS; ++k) s[k][l] = value[k];
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (uint stride = VB_CHECK_WG / 2; stride > 0; stride /= 2) {
-    if (l < stride)
-      for (int k = 0; k < VB_VOLUME_SLOTS; ++k) s[k][l] += s[k][l + stride];
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
+  sum_over_group(s, value, l);
   if (l == 0) {
     const real volume = s[0][0] / (real)6, wgg = s[1][0], gg = s[3][0];
     scalars[0] = wgg > 0 ? (rest_volume - volume) / wgg : 0;  // λ

@@ -53,17 +53,15 @@ std::string element_name(const Lattice& lattice, std::size_t e) {
 
 /// Throws when a hyperelastic element ends the run inverted or crushed (det F ≤ 0, from the host
 /// fit of element_measures): such a state is not a result, whatever the residual says.
-void require_no_inverted_element(const Scene& scene, const Lattice& lattice, const FinalState& st) {
-  std::vector<bool> hyperelastic;
-  for (const std::string& tissue : lattice.tissue_names) {
-    const auto it = scene.materials.find(tissue);
-    const MaterialSpec* m = it == scene.materials.end() ? nullptr : &it->second;
-    hyperelastic.push_back(m && !m->rigid &&
-                           (m->law == "neo-hookean" || m->law == "mooney-rivlin" || m->law == "ogden"));
-  }
+void require_no_inverted_element(const Lattice& lattice, const ElementArrays& el, const FinalState& st) {
+  // The kernels' law id per tissue: 1 and 2 are the hyperelastic laws (rigid tissue is 0).
+  const auto hyperelastic = [&](std::size_t e) {
+    const double law = el.material_table.empty() ? 0 : el.material_table[lattice.tissue_of_element[e]][0];
+    return law == 1 || law == 2;
+  };
   std::size_t inverted = 0, worst = 0;
   for (std::size_t e = 0; e < lattice.element_count(); ++e) {
-    if (!hyperelastic[lattice.tissue_of_element[e]] || st.volumetric_strain[e] > -1) continue;
+    if (!hyperelastic(e) || st.volumetric_strain[e] > -1) continue;
     if (inverted++ == 0 || st.volumetric_strain[e] < st.volumetric_strain[worst]) worst = e;
   }
   if (inverted == 0) return;
@@ -176,10 +174,12 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
     for (int k = 0; k < 3; ++k) st.position_m[3 * e + k] = X[k] + st.displacement_m[3 * e + k];
   }
   s.volume_change = compute_element_measures(lattice, el.youngs_modulus_pa, st);
-  const SurfaceMesh surface = build_surface(lattice);  // milliseconds (docs/SURFACE.md)
+  // The constraint's mesh when there is one; else built here (milliseconds, docs/SURFACE.md).
+  const SurfaceMesh built = sim.surface_mesh() ? SurfaceMesh{} : build_surface(lattice);
+  const SurfaceMesh& surface = sim.surface_mesh() ? *sim.surface_mesh() : built;
   const double rest_volume = enclosed_volume_m3(surface, element_positions_m(lattice));
   if (rest_volume != 0) s.surface_volume_change = enclosed_volume_m3(surface, st.position_m) / rest_volume - 1;
-  require_no_inverted_element(scene, lattice, st);
+  require_no_inverted_element(lattice, el, st);
 
   s.elements = n;
   s.connections = lattice.connection_count;

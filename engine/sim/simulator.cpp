@@ -104,9 +104,9 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   device_bytes_ = estimated_device_bytes(n_, cells, precision_, el.hyperelastic);
   volume_ = scene.volume.preserve;
   require(!volume_ || scene.volume.every >= 1, "volume.every must be at least 1", "volume.every");
-  SurfaceMesh mesh;
   if (volume_) {
-    mesh = build_surface(lattice);
+    surface_ = build_surface(lattice);
+    const SurfaceMesh& mesh = surface_;
     require(!mesh.triangles.empty(), "the model has no closed surface to preserve the volume of", "volume.preserve",
             "the body is the union of complete dual cells (docs/SURFACE.md): it needs parts two elements thick");
     device_bytes_ += estimated_volume_device_bytes(n_, mesh.surface_element_count, mesh.triangles.size(), precision_);
@@ -200,7 +200,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   check_.setArg(kCheckIndenter + kIndenterArgs, partial_);
   check_.setArg(kCheckIndenter + kIndenterArgs + 1, partial_arg_);
   check_.setArg(kCheckIndenter + kIndenterArgs + 2, cl_uint(n_));
-  if (volume_) make_volume_buffers(mesh);
+  if (volume_) make_volume_buffers(surface_);
 }
 
 void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {

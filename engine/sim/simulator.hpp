@@ -59,6 +59,8 @@ class Simulator {
   std::vector<double> volume_gradient_m2();
   /// volume of the surface at rest (m³, world frame); 0 without [volume] preserve
   double rest_volume_m3() const { return rest_volume_m3_; }
+  /// [volume] preserve only: the surface mesh the constraint uses (else nullptr)
+  const SurfaceMesh* surface_mesh() const { return volume_ ? &surface_ : nullptr; }
 
   double dt_s() const { return dt_.dt_s; }
   const TimeStepChoice& time_step() const { return dt_; }
@@ -123,6 +125,7 @@ class Simulator {
   /// V (m³, world frame) from the last volume_finish
   double read_enclosed_volume_m3() const;
   bool volume_ = false;
+  SurfaceMesh surface_;
   double rest_volume_m3_ = 0, frame_sign_ = 1;  ///< det(rotation): lattice-frame V = sign·V_world
   std::size_t volume_triangles_ = 0, volume_surface_ = 0, volume_groups_ = 0;
   cl::Buffer vol_triangles_, vol_surface_, vol_incident_start_, vol_incident_, vol_grad_, vol_partial_,

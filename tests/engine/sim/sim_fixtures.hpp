@@ -82,6 +82,19 @@ inline std::vector<IndenterSpec> plate_pair(int n, double h, double stretch,
   return {base, top};
 }
 
+/// The stretch of the interior of an n-layer box along z, read between layers 1 and n − 2 like an
+/// extensometer (the outer layers touch the plates): mean layer gap over (n − 3)·h.
+inline double interior_stretch(const Lattice& lattice, const std::vector<double>& position_m, int n, double h) {
+  double z_low = 0, z_high = 0;
+  int count = 0;
+  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+    const int k = lattice.voxel_ijk(e)[2];
+    if (k == 1) z_low += position_m[3 * e + 2], ++count;
+    if (k == n - 2) z_high += position_m[3 * e + 2];
+  }
+  return (z_high - z_low) / count / ((n - 3) * h);
+}
+
 struct Model {
   Lattice lattice;
   ElementArrays elements;

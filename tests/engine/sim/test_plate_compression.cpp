@@ -40,14 +40,7 @@ TEST_P(PlateCompression, NominalStressMatchesClosedForm) {
   const double force = out.summary.indenters[1].reaction_force_n.z();  // tissue pushes the top plate up
   const double nominal = force / (span * span);
   // The interior must follow the plates: a check that no hourglass pattern takes up the strain.
-  double z_low = 0, z_high = 0;
-  int count = 0;
-  for (std::size_t e = 0; e < m.lattice.element_count(); ++e) {
-    const auto ijk = m.lattice.voxel_ijk(e);
-    if (ijk[2] == 1) z_low += out.state.position_m[3 * e + 2], ++count;
-    if (ijk[2] == n - 2) z_high += out.state.position_m[3 * e + 2];
-  }
-  const double interior_stretch = (z_high - z_low) / count / ((n - 3) * h);
+  const double interior_stretch = test::interior_stretch(m.lattice, out.state.position_m, n, h);
   EXPECT_NEAR(interior_stretch, c.stretch, 0.01 * (1 - c.stretch)) << "the interior follows the plates";
   const double exact = -uniaxial_nominal_stress(law_of(s.materials.at("soft")), c.stretch);
   RecordProperty(std::string(c.law) + "_" + std::to_string(c.stretch), std::to_string(nominal / exact));
