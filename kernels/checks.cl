@@ -4,9 +4,14 @@
 //   2 kinetic energy (J)                            3 max |u| (m)
 //   4 non-finite elements
 //   5 + 4i .. 7 + 4i  force of the tissue on indenter i (N), 8 + 4i  its contact elements
-// `partial_arg` holds, per group, the element with the largest speed (first non-finite wins).
-// With VB_VOLUME the residual is that of the constrained problem: the pressure term p·g
-// (kernels/volume.cl, computed just before) is taken off the static force of surface elements.
+// With VB_RELAX (dynamic relaxation, kernels/relax.cl) four more sums follow: Rayleigh quotients,
+// each ≥ the lowest mode's ω², that the host sets the damping from (Underwood). One is of the
+// displacement u (the lattice force is zero at rest), one of the change Δu since the previous
+// check (stored in relax_prev with the lattice force then), which late in a relaxation is the
+// slowest mode itself. With R = 5 + 4·VB_INDENTERS:
+//   R     uᵀKu = −Σ u·f_lattice(u)          R + 1  uᵀM̃u = Σ m̃|u|²
+//   R + 2 ΔuᵀKΔu = −Σ Δu·Δf_lattice         R + 3  ΔuᵀM̃Δu = Σ m̃|Δu|²
+// (J and kg·m²; exact for linear springs, secant/tangent-like for the other laws).
 #define VB_SLOT_SUM(s) ((s) == 2 || (s) >= 4)
 
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
@@ -14,6 +19,9 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
                  VB_INDENTER_PARAMS, global real* partial, global int* partial_arg, uint n
 #if VB_VOLUME
                  , global const real4* volume_grad, global const real* volume_scalars
+#endif
+#if VB_RELAX
+                 , global const real* relax_scale, global real4* relax_prev
 #endif
                  ) {
   local real s[VB_CHECK_SLOTS][VB_CHECK_WG];
@@ -31,6 +39,22 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
     value[4] = finite ? 0 : 1;
     if (finite && ui.w != 0) {
       real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
+#if VB_RELAX
+      const int R = 5 + 4 * VB_INDENTERS;
+#if VB_GRAVITY
+      const real4 f_lattice = xyz0(f - xyz0(gravity) / ui.w);
+#else
+      const real4 f_lattice = xyz0(f);
+#endif
+      const real4 du = xyz0(ui) - relax_prev[2 * e];
+      const real scaled_mass = 1 / (ui.w * relax_scale[e]);
+      value[R] = -dot3(ui, f_lattice);
+      value[R + 1] = dot3(ui, ui) * scaled_mass;
+      value[R + 2] = -dot3(du, f_lattice - relax_prev[2 * e + 1]);
+      value[R + 3] = dot3(du, du) * scaled_mass;
+      relax_prev[2 * e] = xyz0(ui);
+      relax_prev[2 * e + 1] = f_lattice;
+#endif
 #if VB_VOLUME
       f -= volume_scalars[3] * volume_grad[e];
 #endif

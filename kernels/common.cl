@@ -7,6 +7,7 @@
 //   -DVB_BIPHASIC=0|1 biphasic-spring tissues present (kernels/lattice_forces.cl)
 //   -DVB_CHECK_WG=N   work-group size of the reduction kernel
 //   -DVB_VOLUME=0|1   volume-preservation constraint on (kernels/volume.cl)
+//   -DVB_RELAX=0|1    dynamic relaxation (kernels/relax.cl): two more check slots
 // and prepends the lattice tables (VB_DIR, VB_DIR_LEN, VB_KAPPA) generated from the host's
 // single definition (engine/sim/kernel_tables.cpp).
 #if VB_DOUBLE

@@ -69,13 +69,15 @@ struct MaterialSpec {
   int line = 0;
 };
 
-enum class Integrator { SymplecticEuler, Heun };
+/// Relaxation: dynamic relaxation for the static answer only (fictitious masses and damping;
+/// docs/PHYSICS.md, "Fast equilibrium").
+enum class Integrator { SymplecticEuler, Heun, Relaxation };
 enum class Precision { Float, Double };
 
 struct SolverSpec {
   Integrator integrator = Integrator::Heun;
   std::optional<double> dt_s;       ///< empty: "auto" (stable step from the stiffest mode)
-  double dt_safety = 0.5;           ///< fraction of the stability limit that "auto" uses
+  double dt_safety = 0.5;           ///< fraction of the stability limit that "auto" uses (relaxation: 0.9)
   Precision precision = Precision::Float;
   double damping_per_s = 0;         ///< global mass-proportional viscous damping γ (1/s): f = -mγv
   double dashpot_ratio = 0.1;       ///< connection dashpot damping ratio ζ: c = 2ζ√(k·m_reduced)

@@ -12,7 +12,9 @@
 namespace vb {
 namespace {
 
-const char* integrator_name(Integrator i) { return i == Integrator::Heun ? "heun" : "symplectic_euler"; }
+const char* integrator_name(Integrator i) {
+  return i == Integrator::Heun ? "heun" : i == Integrator::Relaxation ? "relaxation" : "symplectic_euler";
+}
 
 /// The tissue whose free elements have the largest stability modulus per mass: the one that sets
 /// the estimated stable step (docs/PHYSICS.md, sections 3 and 8).
@@ -152,7 +154,9 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
       ir.history.push_back({sim.time_s(), f.x(), f.y(), f.z(), travel});
     }
     if (progress) progress({sim.steps(), max_steps, sim.time_s(), s.final_residual, s.final_speed_ratio});
-    const bool settled = tol > 0 && s.final_residual <= tol && s.final_speed_ratio <= tol && sim.time_s() >= travel_end;
+    // A relaxation's velocities are fictitious (scaled masses): its equilibrium is the residual's.
+    const bool at_rest = s.final_speed_ratio <= tol || scene.solver.integrator == Integrator::Relaxation;
+    const bool settled = tol > 0 && s.final_residual <= tol && at_rest && sim.time_s() >= travel_end;
     if (settled) {
       s.converged = true;
       s.stop_reason = "equilibrium";

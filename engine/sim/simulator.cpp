@@ -90,6 +90,9 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
           "double precision requested but device '" + cl.info.name + "' has no fp64 support",
           "solver.precision", "use precision = \"float\" or another device");
   dt_ = choose_time_step(scene, lattice, el);
+  relax_ = scene.solver.integrator == Integrator::Relaxation;
+  damping_ = relax_ ? 0.0 : scene.solver.damping_per_s;  // relaxation: set from the first check on
+  gravity_ = scene.gravity.active ? scene.gravity.acceleration_m_s2 : Vec3::Zero();
   require(dt_.dt_s > 0 && std::isfinite(dt_.dt_s), "time step must be positive and finite", "solver.dt");
 
   // Padded voxel grid: one empty layer on every side, so neighbour lookups never leave it.
@@ -102,6 +105,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
 
   const std::size_t state_bytes = 4 * real_size_ * n_;
   device_bytes_ = estimated_device_bytes(n_, cells, precision_, el.hyperelastic);
+  if (relax_) device_bytes_ += n_ * 9 * real_size_;  // mass scale; u and lattice force at the last check
   volume_ = scene.volume.preserve;
   require(!volume_ || scene.volume.every >= 1, "volume.every must be at least 1", "volume.every");
   if (volume_) {
@@ -139,18 +143,21 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   check_groups_ = (n_ + wg - 1) / wg;
   global_ = cl::NDRange(check_groups_ * wg);
   local_ = cl.info.is_gpu ? cl::NDRange(wg) : cl::NullRange;  // PoCL picks faster sizes itself
-  check_slots_ = kCheckBaseSlots + kCheckSlotsPerIndenter * int(scene.indenters.size());
+  check_slots_ = kCheckBaseSlots + kCheckSlotsPerIndenter * int(scene.indenters.size()) + (relax_ ? 4 : 0);
   partial_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * check_slots_ * real_size_);
   indenters_ = make_real_buffer(indenter_table());
   partial_arg_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * sizeof(cl_int));
 
   // Only the features this scene uses are compiled in.
-  const bool gravity = scene.gravity.active && scene.gravity.acceleration_m_s2.squaredNorm() > 0;
+  // Gravity is compiled in whenever the scene has a [gravity] section (set_gravity may change it).
+  const bool gravity = scene.gravity.active;
   std::string options = "-cl-std=CL1.2 -cl-mad-enable";  // 2× on PoCL; a·b+c rounding only
   options += " -DVB_DOUBLE=" + std::to_string(precision_ == Precision::Double);
   options += " -DVB_GRAVITY=" + std::to_string(gravity);
-  options += " -DVB_DASHPOT=" + std::to_string(scene.solver.dashpot_ratio > 0);
-  options += " -DVB_GLOBAL_DAMPING=" + std::to_string(scene.solver.damping_per_s > 0);
+  // Relaxation damps with its own adaptive rate (kernels/relax.cl); dashpots would only slow it.
+  options += " -DVB_DASHPOT=" + std::to_string(!relax_ && scene.solver.dashpot_ratio > 0);
+  options += " -DVB_GLOBAL_DAMPING=" + std::to_string(!relax_ && scene.solver.damping_per_s > 0);
+  options += " -DVB_RELAX=" + std::to_string(relax_);
   options += " -DVB_INDENTERS=" + std::to_string(scene.indenters.size());
   options += " -DVB_CHECK_SLOTS=" + std::to_string(check_slots_);
   options += " -DVB_RSQRT=" + std::to_string(cl.info.is_gpu);
@@ -160,6 +167,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_VOLUME=" + std::to_string(volume_);
   std::vector<std::string> sources = {"common.cl", "hyperelastic.cl", "lattice_forces.cl", "integrate.cl"};
   if (volume_) sources.push_back("volume.cl");
+  if (relax_) sources.push_back("relax.cl");
   sources.push_back("checks.cl");
   program_ = build_program(cl, sources, lattice_tables_source(), options);
   if (hyper_) {
@@ -180,11 +188,15 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   if (heun) {
     predict_ = cl::Kernel(program_, "heun_predict");
     correct_ = cl::Kernel(program_, "heun_correct");
+  } else if (relax_) {
+    relax_kernel_ = cl::Kernel(program_, "relax_step");
+    relax_scale_ = make_real_buffer(relaxation_mass_scale(lattice, el));
+    relax_kernel_.setArg(kStepIndenter + kIndenterArgs + 2, relax_scale_);
   } else {
     euler_ = cl::Kernel(program_, "euler_step");
   }
   check_ = cl::Kernel(program_, "check_state");
-  for (cl::Kernel* k : {&euler_, &predict_, &correct_}) {
+  for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_}) {
     if (!(*k)()) continue;
     set_lattice_args(*k, kStepLattice);
     set_indenter_args(*k, kStepIndenter, 0.0, 0.0);
@@ -200,6 +212,14 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   check_.setArg(kCheckIndenter + kIndenterArgs, partial_);
   check_.setArg(kCheckIndenter + kIndenterArgs + 1, partial_arg_);
   check_.setArg(kCheckIndenter + kIndenterArgs + 2, cl_uint(n_));
+  if (relax_) {
+    check_.setArg(kCheckVolume + (volume_ ? 2 : 0), relax_scale_);
+    // u and the lattice force at the previous check; zero = the rest state, where both are zero
+    std::vector<char> zeros(2 * 4 * real_size_ * n_, 0);
+    relax_prev_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, zeros.size(), zeros.data());
+    check_.setArg(kCheckVolume + (volume_ ? 3 : 1), relax_prev_);
+    set_real(relax_kernel_, kStepIndenter + kIndenterArgs + 3, damping_);
+  }
   if (volume_) make_volume_buffers(surface_);
 }
 
@@ -372,8 +392,8 @@ void Simulator::set_lattice_args(cl::Kernel& k, int a) {
   k.setArg(a + 4, cl_int(stride_z_));
   set_real(k, a + 5, lattice_.spacing_m);
   set_real(k, a + 6, scene_.solver.dashpot_ratio);
-  set_world_vector(k, a + 7, scene_.gravity.active ? scene_.gravity.acceleration_m_s2 : Vec3::Zero());
-  set_real(k, a + 8, scene_.solver.damping_per_s);
+  set_world_vector(k, a + 7, gravity_);
+  set_real(k, a + 8, damping_);
   set_world_vector(k, a + 9, lattice_.origin_m);
   k.setArg(a + 10, tissue_);
   k.setArg(a + 11, materials_);
@@ -441,10 +461,11 @@ void Simulator::advance(std::int64_t steps) {
       enqueue_stress(u_tmp_);
       enqueue(correct_);
     } else {
-      euler_.setArg(0, u_); euler_.setArg(1, v_); euler_.setArg(2, u_tmp_); euler_.setArg(3, v_tmp_);
-      if (indenter) set_indenter_args(euler_, kStepIndenter, t0, t1);
+      cl::Kernel& k = relax_ ? relax_kernel_ : euler_;
+      k.setArg(0, u_); k.setArg(1, v_); k.setArg(2, u_tmp_); k.setArg(3, v_tmp_);
+      if (indenter) set_indenter_args(k, kStepIndenter, t0, t1);
       enqueue_stress(u_);
-      enqueue(euler_);
+      enqueue(k);
       std::swap(u_, u_tmp_);
       std::swap(v_, v_tmp_);
     }
@@ -491,7 +512,35 @@ StateCheck Simulator::check() {
     }
   }
   if (volume_) c.enclosed_volume_m3 = read_enclosed_volume_m3();
+  if (relax_) adapt_relaxation_damping(c, p);
   return c;
+}
+
+void Simulator::adapt_relaxation_damping(StateCheck& c, const std::vector<double>& partial) {
+  // Underwood's adaptive dynamic relaxation: c = 2·ω_min damps the slowest mode critically. Every
+  // Rayleigh quotient is ≥ ω_min², so the smallest one seen (of u, of the change since the last
+  // check, and the previous estimate) is the best; it only moves down, towards ω_min². Capped
+  // where symplectic Euler's damping factor 1 − c·dt would stop contracting.
+  const int R = check_slots_ - 4;
+  std::array<double, 4> sum{};
+  for (std::size_t g = 0; g < check_groups_; ++g)
+    for (int k = 0; k < 4; ++k) sum[k] += partial[g * check_slots_ + R + k];
+  double omega_sq = relax_omega_sq_;
+  for (int k : {0, 2})
+    if (sum[k] > 0 && sum[k + 1] > 0) omega_sq = std::min(omega_sq, sum[k] / sum[k + 1]);
+  if (!std::isfinite(omega_sq)) return;  // no displacement yet: keep c
+  relax_omega_sq_ = c.rayleigh_omega_sq = omega_sq;
+  damping_ = std::min(2 * std::sqrt(omega_sq), 0.5 / dt_.dt_s);
+  set_real(relax_kernel_, kStepIndenter + kIndenterArgs + 3, damping_);
+}
+
+void Simulator::set_gravity(const Vec3& g) {
+  require(scene_.gravity.active, "gravity can change only in a scene with a [gravity] section", "gravity");
+  gravity_ = g;
+  for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_})
+    if ((*k)()) set_world_vector(*k, kStepLattice + 7, g);
+  set_world_vector(check_, kCheckLattice + 7, g);
+  if (volume_) set_world_vector(vol_partials_, 2 + 7, g);
 }
 
 template <typename T>

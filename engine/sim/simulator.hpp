@@ -2,6 +2,7 @@
 /// The OpenCL simulator: device buffers for one model, kernels built with only the features the
 /// scene uses, and time stepping without host synchronisation between checks.
 #include <CL/opencl.hpp>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -26,6 +27,9 @@ struct StateCheck {
   std::int64_t fastest_element = -1;  ///< element with the largest speed (or first non-finite)
   /// [volume] preserve only: volume enclosed by the surface (m³, world frame); else 0
   double enclosed_volume_m3 = 0;
+  /// relaxation only: Rayleigh quotient uᵀKu / uᵀM̃u of the displacement (1/s²), the estimate of
+  /// the lowest mode's ω² that sets the damping (kernels/checks.cl); else 0
+  double rayleigh_omega_sq = 0;
 };
 
 /// Device bytes a model of `elements` elements in a padded grid of `cells` voxels needs
@@ -45,8 +49,16 @@ class Simulator {
 
   /// Enqueues `steps` time steps; returns without waiting for the device.
   void advance(std::int64_t steps);
-  /// Runs the reduction kernel on the current state and waits for it.
+  /// Runs the reduction kernel on the current state and waits for it. With the relaxation
+  /// integrator it also sets the damping of the next steps to 2·√(Rayleigh quotient), critical
+  /// for the lowest mode (docs/PHYSICS.md, "Fast equilibrium").
   StateCheck check();
+  /// Changes gravity (world frame, m/s²) from the next step on: a posture change.
+  void set_gravity(const Vec3& acceleration_m_s2);
+  /// Counts time from zero again (the next run starts at t = 0, indenters at their start).
+  void restart_clock() { steps_ = 0; }
+  /// relaxation: the damping rate the steps use now (1/s); else the scene's global damping
+  double damping_per_s() const { return damping_; }
 
   /// Current state as n×3 doubles in the world frame.
   void download(std::vector<double>& u_m, std::vector<double>& v_m_s) const;
@@ -85,6 +97,7 @@ class Simulator {
   std::vector<double> to_lattice_frame(const std::vector<double>& world) const;
   void enqueue(cl::Kernel& k) const;
   void enqueue_check() const;
+  void adapt_relaxation_damping(StateCheck& c, const std::vector<double>& partial);
   void enqueue_stress(const cl::Buffer& u);
   void make_hyperelastic_buffers(const ElementArrays& el);
   std::vector<double> indenter_table() const;
@@ -112,7 +125,12 @@ class Simulator {
   int check_slots_ = 0;  ///< hyperelastic: tissue ids, law table, Q and F rows
   cl::Kernel stress_;
   cl::Program program_;
-  cl::Kernel euler_, predict_, correct_;
+  cl::Kernel euler_, predict_, correct_, relax_kernel_;
+  bool relax_ = false;
+  double damping_ = 0;  ///< global damping (1/s); adapted at each check when relaxing
+  double relax_omega_sq_ = INFINITY;  ///< relaxation: smallest Rayleigh quotient so far (1/s²)
+  Vec3 gravity_ = Vec3::Zero();
+  cl::Buffer relax_scale_, relax_prev_;
   mutable cl::Kernel check_;
 
   // Volume constraint ([volume] preserve): the surface mesh, uploaded once.

@@ -9,39 +9,66 @@
 
 namespace vb {
 
+namespace {
+
+/// Gershgorin row bounds of M⁻¹K and M⁻¹C (dashpots only) of a free element, over its 3 rows.
+std::pair<double, double> element_rows(const Lattice& lattice, const ElementArrays& el, double dashpot_ratio,
+                                       std::size_t e) {
+  const auto& offsets = neighbour_offsets();
+  const auto k = connection_stiffness(lattice, el.stability_modulus_pa, e);
+  const auto k_dashpot = connection_stiffness(lattice, el.youngs_modulus_pa, e);  // what the dashpots use
+  const auto nb = lattice.neighbours(e);
+  double omega_sq = 0, c_max = 0;
+  for (int a = 0; a < 3; ++a) {
+    double k_row = 0, c_row = 0;
+    for (int d = 0; d < 26; ++d) {
+      if (k[d] == 0) continue;
+      const Vec3 n = Vec3(offsets[d][0], offsets[d][1], offsets[d][2]).normalized();
+      const double w = std::abs(n[a]) * n.cwiseAbs().sum();  // Σ_b |n_a n_b|
+      const double reduced_mass = 1.0 / (el.inverse_mass[e] + el.inverse_mass[nb[d]]);
+      k_row += 2 * k[d] * w;
+      c_row += 2 * (2 * dashpot_ratio * std::sqrt(k_dashpot[d] * reduced_mass)) * w;
+    }
+    omega_sq = std::max(omega_sq, k_row * el.inverse_mass[e]);
+    c_max = std::max(c_max, c_row * el.inverse_mass[e]);
+  }
+  return {omega_sq, c_max};
+}
+
+}  // namespace
+
 StabilityBounds stability_bounds(const Lattice& lattice, const ElementArrays& el, double dashpot_ratio,
                                  double global_damping) {
-  const auto& offsets = neighbour_offsets();
   StabilityBounds b;
   double omega_sq = 0, c_max = 0;
   for (std::size_t e = 0; e < lattice.element_count(); ++e) {
     if (el.inverse_mass[e] == 0) continue;
-    const auto k = connection_stiffness(lattice, el.stability_modulus_pa, e);
-    const auto k_dashpot = connection_stiffness(lattice, el.youngs_modulus_pa, e);  // what the dashpots use
-    const auto nb = lattice.neighbours(e);
-    for (int a = 0; a < 3; ++a) {
-      double k_row = 0, c_row = 0;
-      for (int d = 0; d < 26; ++d) {
-        if (k[d] == 0) continue;
-        const Vec3 n = Vec3(offsets[d][0], offsets[d][1], offsets[d][2]).normalized();
-        const double w = std::abs(n[a]) * n.cwiseAbs().sum();  // Σ_b |n_a n_b|
-        const double reduced_mass = 1.0 / (el.inverse_mass[e] + el.inverse_mass[nb[d]]);
-        k_row += 2 * k[d] * w;
-        c_row += 2 * (2 * dashpot_ratio * std::sqrt(k_dashpot[d] * reduced_mass)) * w;
-      }
-      omega_sq = std::max(omega_sq, k_row * el.inverse_mass[e]);
-      c_max = std::max(c_max, c_row * el.inverse_mass[e]);
-    }
+    const auto [w2, c] = element_rows(lattice, el, dashpot_ratio, e);
+    omega_sq = std::max(omega_sq, w2);
+    c_max = std::max(c_max, c);
   }
   b.omega_max = std::sqrt(omega_sq);
   b.damping_max = c_max + global_damping;
   return b;
 }
 
+std::vector<double> relaxation_mass_scale(const Lattice& lattice, const ElementArrays& el) {
+  std::vector<double> scale(lattice.element_count(), 1.0), omega_sq(lattice.element_count(), 0.0);
+  double highest = 0;
+  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+    if (el.inverse_mass[e] == 0) continue;
+    omega_sq[e] = element_rows(lattice, el, 0, e).first;
+    highest = std::max(highest, omega_sq[e]);
+  }
+  for (std::size_t e = 0; e < lattice.element_count(); ++e)
+    if (omega_sq[e] > 0) scale[e] = highest / omega_sq[e];
+  return scale;
+}
+
 double amplification(Integrator integrator, double w, double c, double dt) {
   // One step maps (x, v) → A (x, v); A's eigenvalues from its trace and determinant.
   double a11, a12, a21, a22;
-  if (integrator == Integrator::SymplecticEuler) {
+  if (integrator != Integrator::Heun) {  // symplectic Euler (relaxation steps with it too)
     a21 = -dt * w * w;
     a22 = 1 - c * dt;
     a11 = 1 + dt * a21;
@@ -82,8 +109,14 @@ double stable_time_step(Integrator integrator, const StabilityBounds& b, double 
 TimeStepChoice choose_time_step(const Scene& scene, const Lattice& lattice, const ElementArrays& el) {
   TimeStepChoice choice;
   const SolverSpec& s = scene.solver;
-  choice.bounds = stability_bounds(lattice, el, s.dashpot_ratio, s.damping_per_s);
-  choice.stable_limit_s = stable_time_step(s.integrator, choice.bounds, s.damping_per_s);
+  if (s.integrator == Integrator::Relaxation) {
+    // Symplectic Euler without dashpots (they do not act), every element at the bound ω_max.
+    choice.bounds = stability_bounds(lattice, el, 0, 0);
+    choice.stable_limit_s = stable_time_step(Integrator::SymplecticEuler, choice.bounds, 0);
+  } else {
+    choice.bounds = stability_bounds(lattice, el, s.dashpot_ratio, s.damping_per_s);
+    choice.stable_limit_s = stable_time_step(s.integrator, choice.bounds, s.damping_per_s);
+  }
   if (s.dt_s) {
     choice.dt_s = *s.dt_s;
     choice.automatic = false;

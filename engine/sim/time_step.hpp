@@ -16,6 +16,11 @@ struct StabilityBounds {
 StabilityBounds stability_bounds(const Lattice& lattice, const ElementArrays& elements,
                                  double dashpot_ratio, double global_damping_per_s);
 
+/// Dynamic relaxation's mass scaling (kernels/relax.cl): per element m/m̃ ≥ 1, chosen so that
+/// every free element's Gershgorin bound with its scaled mass m̃ equals the model's ω_max;
+/// 1 for held elements.
+std::vector<double> relaxation_mass_scale(const Lattice& lattice, const ElementArrays& elements);
+
 /// Largest dt for which the integrator is stable on ẍ = −ω²x − c(ω)ẋ for all ω ≤ ω_max, with
 /// c(ω) = γ + (c_max − γ)(ω/ω_max)² (dashpots are stiffness-proportional, global damping not).
 /// Returns 0 when no positive step is stable (Heun without any damping).

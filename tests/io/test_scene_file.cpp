@@ -559,3 +559,18 @@ TEST(SceneFileImage, ReadsAnImageModelWithDefaultsAndRelativePaths) {
 
 }  // namespace
 }  // namespace vb
+
+namespace vb {
+namespace {
+
+TEST(SceneFile, RelaxationIntegratorRunsCloserToTheStabilityLimit) {
+  const Scene relax = parse_scene_text(kBase + "[solver]\nintegrator = \"relaxation\"\n", "relax.toml");
+  EXPECT_EQ(relax.solver.integrator, Integrator::Relaxation);
+  EXPECT_DOUBLE_EQ(relax.solver.dt_safety, 0.9);  // its default; the others keep 0.5
+  EXPECT_DOUBLE_EQ(parse_scene_text(kBase, "base.toml").solver.dt_safety, 0.5);
+  const Scene given = parse_scene_text(kBase + "[solver]\nintegrator = \"relaxation\"\ndt_safety = 0.6\n", "r.toml");
+  EXPECT_DOUBLE_EQ(given.solver.dt_safety, 0.6);
+}
+
+}  // namespace
+}  // namespace vb

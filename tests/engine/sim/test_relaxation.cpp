@@ -1,0 +1,151 @@
+// Dynamic relaxation (solver.integrator = "relaxation"): it must land on the same equilibrium as
+// plain damped dynamics, in far fewer steps (docs/PHYSICS.md, "Fast equilibrium"; issue 7).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+
+#include "engine/image/image_lattice.hpp"
+#include "engine/loads/posture.hpp"
+#include "engine/sim/run.hpp"
+#include "engine/sim/simulator.hpp"
+#include "engine/sim/time_step.hpp"
+#include "io/nifti_io.hpp"
+#include "io/scene_file.hpp"
+#include "tests/engine/sim/sim_fixtures.hpp"
+
+namespace vb {
+namespace {
+
+using test::cl_context;
+
+double max_difference_m(const std::vector<double>& a, const std::vector<double>& b) {
+  double worst = 0;
+  for (std::size_t e = 0; e < a.size() / 3; ++e)
+    worst = std::max(worst, std::hypot(a[3 * e] - b[3 * e], a[3 * e + 1] - b[3 * e + 1], a[3 * e + 2] - b[3 * e + 2]));
+  return worst;
+}
+
+struct Settled {
+  std::vector<double> u;
+  std::int64_t steps = 0;
+  double max_displacement_m = 0;
+};
+
+Settled settle(const Scene& s, const Lattice& lattice, const ElementArrays& el) {
+  Simulator sim(s, lattice, el, cl_context());
+  const RunOutput out = run_simulation(s, lattice, el, sim);
+  EXPECT_TRUE(out.summary.converged) << out.summary.stop_reason;
+  return {out.state.displacement_m, out.summary.steps, out.summary.max_displacement_m};
+}
+
+/// A 5×5×8 column (E = 30 kPa) on a held base, sagging sideways under gravity along x (bending +
+/// shear; about 6 mm at the top).
+Scene column_scene(const std::string& law, Integrator integrator) {
+  const double h = 0.004;
+  Scene s = test::box_scene(5, 5, 8, h, 30000);
+  if (law != "linear") {
+    s.materials["soft"] = test::validation_material(law, 0.45);
+    s.materials["soft"].youngs_modulus_pa *= 10;
+    for (double& mu : s.materials["soft"].ogden_mu_pa) mu *= 10;
+  }
+  s.anchors.push_back(test::halfspace_anchor("base", Vec3(0, 0, h), Vec3(0, 0, -1)));
+  s.gravity.active = true;
+  s.gravity.acceleration_m_s2 = Vec3(9.81, 0, -9.81);
+  s.solver.integrator = integrator;
+  s.solver.precision = Precision::Double;
+  s.solver.damping_per_s = 50;
+  s.solver.dashpot_ratio = 0.1;
+  if (integrator == Integrator::Relaxation) s.solver.dt_safety = 0.9;
+  s.solver.check_every = 10;
+  s.stop.equilibrium = 1e-6;
+  s.stop.max_steps = 400000;
+  return s;
+}
+
+class RelaxationColumn : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(RelaxationColumn, ReachesTheDampedEquilibriumInFewerSteps) {
+  const Scene damped_scene = column_scene(GetParam(), Integrator::Heun);
+  const test::Model m = test::make_model(damped_scene);
+  const Settled damped = settle(damped_scene, m.lattice, m.elements);
+  const Settled relaxed = settle(column_scene(GetParam(), Integrator::Relaxation), m.lattice, m.elements);
+  const double difference = max_difference_m(damped.u, relaxed.u);
+  std::cout << GetParam() << ": damped Heun " << damped.steps << " steps, relaxation " << relaxed.steps
+            << " steps; max displacement " << damped.max_displacement_m * 1e3 << " mm, difference "
+            << difference * 1e3 << " mm\n";
+  EXPECT_GT(damped.max_displacement_m, 1e-4);  // the load does something
+  // Both stop at a residual of 1e-6·E·h²: they agree to a hundredth of a millimetre (the issue's
+  // bar for the phantom is 0.1 mm), under 0.2% of the largest displacement.
+  EXPECT_LT(difference, 1e-5);
+  EXPECT_LT(difference, 2e-3 * damped.max_displacement_m);
+  // One force evaluation per step instead of Heun's two, and fewer steps.
+  EXPECT_LT(relaxed.steps, damped.steps / 2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Laws, RelaxationColumn, ::testing::Values("linear", "neo-hookean", "ogden"),
+                         [](const auto& info) { return info.param == "neo-hookean" ? std::string("neo_hookean") : info.param; });
+
+TEST(RelaxationMassScale, PutsEveryElementAtTheStiffestElementsFrequency) {
+  // Left half 10× stiffer: its elements keep their mass, the soft ones get ~10× lighter.
+  Scene s = test::box_scene(8, 4, 4, 0.004);
+  ShapeSpec stiff = s.model.shapes[0];
+  stiff.max_m.x() = 0.016;
+  stiff.label = "stiff";
+  s.model.shapes.push_back(stiff);
+  s.materials["stiff"] = test::material("stiff", 30000);
+  const test::Model m = test::make_model(s);
+  const std::vector<double> scale = relaxation_mass_scale(m.lattice, m.elements);
+  double lowest = INFINITY, highest = 0;
+  for (std::size_t e = 0; e < scale.size(); ++e) {
+    lowest = std::min(lowest, scale[e]);
+    highest = std::max(highest, scale[e]);
+    const bool soft_interior = m.lattice.voxel_ijk(e)[0] >= 5;
+    if (m.lattice.tissue_names[m.lattice.tissue_of_element[e]] == "stiff") EXPECT_LT(scale[e], 4.0) << e;
+    if (soft_interior) EXPECT_GT(scale[e], 5.0) << e;
+  }
+  EXPECT_DOUBLE_EQ(lowest, 1.0);
+  EXPECT_GT(highest, 9.0);
+}
+
+// The phantom CT (bundled sample, 4 mm lattice): settled supine, then turned prone. Relaxation
+// must land within 0.1 mm of plain damped dynamics (the sample's Heun with damping 40/s) in at
+// most 10% of its steps.
+TEST(RelaxationPhantom, SupineToProneFlipMatchesDampedDynamics) {
+  const std::string dir = std::string(VOXBREAST_SOURCE_DIR) + "/data-samples/phantom/";
+  Scene scene = parse_scene_file(dir + "scene.toml");
+  const ImageVolume ct = read_nifti(scene.model.image_path), labels = read_nifti(scene.model.labels_path);
+  const Lattice lattice = build_lattice(
+      lattice_volume_from_image(scene.model, ct, classify_image(scene.model, ct, &labels)), scene.model.downsample);
+  const ElementArrays el = make_element_arrays(scene, lattice);
+  scene.stop.max_steps = 400000;
+  scene.solver.check_every = 10;
+
+  auto flip = [&](Integrator integrator) {
+    Scene s = scene;
+    s.solver.integrator = integrator;
+    if (integrator == Integrator::Relaxation) s.solver.dt_safety = 0.9, s.solver.check_every = 5;
+    s.gravity.acceleration_m_s2 = gravity_for_posture("supine");
+    Simulator sim(s, lattice, el, cl_context());
+    const RunOutput supine = run_simulation(s, lattice, el, sim);
+    EXPECT_TRUE(supine.summary.converged);
+    sim.set_gravity(gravity_for_posture("prone"));
+    sim.restart_clock();
+    const RunOutput prone = run_simulation(s, lattice, el, sim);
+    EXPECT_TRUE(prone.summary.converged);
+    return std::make_pair(prone, max_difference_m(supine.state.displacement_m, prone.state.displacement_m));
+  };
+  const auto [damped, damped_move] = flip(Integrator::Heun);
+  const auto [relaxed, relaxed_move] = flip(Integrator::Relaxation);
+  const double difference = max_difference_m(damped.state.displacement_m, relaxed.state.displacement_m);
+  std::cout << "phantom supine→prone: damped Heun " << damped.summary.steps << " steps (" << damped.summary.wall_time_s
+            << " s), relaxation " << relaxed.summary.steps << " steps (" << relaxed.summary.wall_time_s
+            << " s); largest move " << damped_move * 1e3 << " mm; difference " << difference * 1e3 << " mm\n";
+  EXPECT_GT(damped_move, 1e-3);  // the flip moves tissue by millimetres
+  EXPECT_LT(difference, 1e-4);
+  EXPECT_LE(relaxed.summary.steps, damped.summary.steps / 10);
+}
+
+}  // namespace
+}  // namespace vb
