@@ -4,6 +4,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -54,7 +55,7 @@ nlohmann::json sweep_definition(const SweepGrid& grid, const std::string& scene_
   nlohmann::json parameters = nlohmann::json::array();
   for (const SweepParameter& p : grid.parameters())
     parameters.push_back({{"key", p.key}, {"add", p.add}, {"values", p.values}});
-  return {{"scene", fs::absolute(scene_path).lexically_normal().string()},
+  return {{"scene", fs::weakly_canonical(fs::absolute(scene_path)).string()},
           {"scene_text", scene_text},
           {"outputs", outputs},
           {"parameters", parameters},
@@ -130,12 +131,16 @@ SweepCaseRecord SweepFolder::read_record(std::size_t index) const {
   return r;
 }
 
-void SweepFolder::remove_leftovers(std::size_t index) const {
-  const std::string prefix = "." + case_id(index) + ".";
+void SweepFolder::remove_leftovers(const std::function<bool(std::size_t)>& owned) const {
   std::error_code ec;
+  std::vector<fs::path> leftovers;
   for (const fs::directory_entry& e : fs::directory_iterator(path("cases"), ec)) {
-    if (e.path().filename().string().rfind(prefix, 0) == 0) fs::remove_all(e.path(), ec);
+    const std::string name = e.path().filename().string();  // .0003.work-r0-p123, .0003.old-p123
+    if (name.size() < 3 || name[0] != '.') continue;
+    const std::size_t id = std::strtoull(name.c_str() + 1, nullptr, 10);
+    if (id >= 1 && id <= case_count_ && owned(id - 1)) leftovers.push_back(e.path());
   }
+  for (const fs::path& p : leftovers) fs::remove_all(p, ec);
 }
 
 std::string SweepFolder::make_work_dir(std::size_t index, int rank) const {

@@ -5,6 +5,7 @@
 ///   DIR/cases/.NNNN.work-*  a case being run (renamed to NNNN when complete, so a folder named
 ///                           NNNN is always complete; leftovers of killed runs are removed)
 ///   DIR/metrics.csv, DIR/timing.csv, DIR/sweep_log.jsonl, DIR/plots/
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -62,8 +63,9 @@ class SweepFolder {
   bool is_finished(std::size_t index) const;
   SweepCaseRecord read_record(std::size_t index) const;
 
-  /// Removes what killed runs left of case `index` (hidden .NNNN.* folders).
-  void remove_leftovers(std::size_t index) const;
+  /// Removes what killed runs left (hidden .NNNN.* folders) of the cases `owned` says are this
+  /// process's; one listing of cases/ for all of them.
+  void remove_leftovers(const std::function<bool(std::size_t)>& owned) const;
   /// A new, empty working folder for case `index` in process `rank`.
   std::string make_work_dir(std::size_t index, int rank) const;
   /// Writes case.json into the working folder and renames it to cases/NNNN (replacing a

@@ -18,10 +18,11 @@ SweepRunReport run_sweep_cases(const SweepFolder& folder, const SweepGrid& grid,
   require(case_scenes.size() == grid.size(), "one scene text per case expected");
   require(!options.workers.empty(), "a sweep needs at least one worker");
   SweepRunReport report;
+  const auto owned = [&](std::size_t i) { return i % std::size_t(options.ranks) == std::size_t(options.rank); };
+  folder.remove_leftovers(owned);
   std::vector<std::size_t> pending;
   for (std::size_t i = std::size_t(options.rank); i < grid.size(); i += std::size_t(options.ranks)) {
     ++report.owned;
-    folder.remove_leftovers(i);
     const bool finished = folder.is_finished(i);
     if (finished && !(options.retry_failed && folder.read_record(i).status != "ok")) {
       ++report.skipped;

@@ -42,7 +42,7 @@ struct Table {
 
 nlohmann::json read_summary(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) return nlohmann::json();
+  if (!in) return nlohmann::json::object();  // a case without summary.json has no metrics
   try {
     return nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
@@ -59,7 +59,7 @@ std::vector<std::string> concat(std::vector<std::string> a, const std::vector<st
 
 std::vector<std::pair<std::string, nlohmann::json>> flatten_scalars(const nlohmann::json& document) {
   std::vector<std::pair<std::string, nlohmann::json>> out;
-  flatten(document, "", out);
+  if (document.is_object() || document.is_array()) flatten(document, "", out);  // a bare scalar has no name
   return out;
 }
 

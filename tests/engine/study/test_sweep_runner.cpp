@@ -125,10 +125,17 @@ TEST_F(SweepRunnerTest, RanksTakeEveryNthCaseAndTogetherMatchOneProcess) {
   SweepRunOptions rank0, rank1;
   rank0.ranks = rank1.ranks = 2;
   rank1.rank = 1;
+  // Leftovers of a killed run: each rank removes only those of its own cases.
+  const fs::path cases = root_ / "ranks" / "cases";
+  fs::create_directories(cases / ".0002.work-r1-p7");  // case index 1: rank 1's
+  fs::create_directories(cases / ".0003.work-r0-p7");  // case index 2: rank 0's
   sweep(root_ / "ranks", rank0, &ran0);
+  EXPECT_TRUE(fs::exists(cases / ".0002.work-r1-p7")) << "rank 0 removed a folder rank 1 may be writing";
+  EXPECT_FALSE(fs::exists(cases / ".0003.work-r0-p7"));
   EXPECT_EQ(ran0, (std::vector<std::size_t>{0, 2, 4, 6}));
   const std::string both = sweep(root_ / "ranks", rank1, &ran1);
   EXPECT_EQ(ran1, (std::vector<std::size_t>{1, 3, 5, 7}));
+  EXPECT_FALSE(fs::exists(cases / ".0002.work-r1-p7"));
   EXPECT_EQ(both, serial);
 }
 
