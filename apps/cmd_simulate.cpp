@@ -4,14 +4,9 @@
 #include <memory>
 
 #include "apps/commands.hpp"
-#include "apps/image_outputs.hpp"
-#include "apps/mesh_outputs.hpp"
 #include "apps/progress.hpp"
-#include "apps/simulation_setup.hpp"
-#include "engine/sim/run.hpp"
+#include "apps/simulation_pipeline.hpp"
 #include "io/atomic_file.hpp"
-#include "io/hdf5_result.hpp"
-#include "io/json_summary.hpp"
 
 namespace vb::app {
 namespace {
@@ -26,40 +21,33 @@ int run_simulate(const SimulateOptions& o) {
   if (!o.series.empty()) scene.model.series_uid = o.series;
   scene.model.allow_gaps = scene.model.allow_gaps || o.allow_gaps;
   ensure_output_dir(o.out);  // fail before computing, not after
-  const PreparedModel model = prepare_model(scene);
   const ClContext cl(select_device(o.device));
-  Simulator sim(scene, model.lattice, model.elements, cl);
-  if (!o.quiet)
-    std::fprintf(stderr, "voxbreast: %zu elements, %zu connections, dt = %.3g s (%s), device %s, %s\n",
-                 model.lattice.element_count(), model.lattice.connection_count, sim.dt_s(),
-                 sim.time_step().automatic ? "auto" : "given", cl.info.name.c_str(),
-                 scene.solver.precision == Precision::Double ? "double" : "float");
   Progress bar(!o.quiet);
-  const RunOutput result = run_simulation(scene, model.lattice, model.elements, sim, [&](const RunProgress& p) {
+  SimulationOptions options;
+  options.on_start = [&](const PreparedModel& model, const Simulator& sim) {
+    if (!o.quiet)
+      std::fprintf(stderr, "voxbreast: %zu elements, %zu connections, dt = %.3g s (%s), device %s, %s\n",
+                   model.lattice.element_count(), model.lattice.connection_count, sim.dt_s(),
+                   sim.time_step().automatic ? "auto" : "given", cl.info.name.c_str(),
+                   scene.solver.precision == Precision::Double ? "double" : "float");
+  };
+  options.on_progress = [&](const RunProgress& p) {
     char text[160];
     std::snprintf(text, sizeof text, "step %lld  t=%.4g s  residual %.2e  speed %.2e", (long long)p.step, p.time_s,
                   p.residual, p.speed_ratio);
     bar.update(double(p.step) / double(p.max_steps), text);
-  });
+  };
+  const SimulationReport report = simulate_scene(scene, cl, o.out, options);
   bar.finish();
 
-  const std::string h5 = o.out + "/result.h5", json = o.out + "/summary.json";
-  write_result_h5(h5, model.lattice, scene, result.state, result.frames, result.summary);
-  nlohmann::json summary = summary_to_json(result.summary, scene);
-  if (model.ct) {
-    summary["image_outputs"] = write_image_outputs(o.out, scene, model.lattice, *model.ct, result.state);
-    summary["warnings"] = model.warnings;
-  }
-  if (scene.output.surfaces) summary["mesh_outputs"] = write_mesh_outputs(o.out, model.lattice, result.state, result.frames);
-  write_text_atomically(json, summary.dump(2) + "\n");
-  const RunSummary& s = result.summary;
+  const RunSummary& s = report.summary;
   std::printf("%s after %lld steps (%.4g s simulated, %.1f s wall, %.0f steps/s); max displacement %.3f mm\n",
               s.converged ? "equilibrium reached" : ("stopped at " + s.stop_reason).c_str(), (long long)s.steps,
               s.simulated_time_s, s.wall_time_s, s.steps_per_second, 1e3 * s.max_displacement_m);
-  for (const std::string& w : model.warnings) std::fprintf(stderr, "voxbreast: warning: %s\n", w.c_str());
-  std::printf("wrote %s\nwrote %s\n", json.c_str(), h5.c_str());
-  if (model.ct) std::printf("wrote DVF, warped CT and fields on the CT grid in %s/\n", o.out.c_str());
-  if (scene.output.surfaces) std::printf("wrote surface meshes (.vtp, .stl, .ply) and lattice.vtu in %s/\n", o.out.c_str());
+  for (const std::string& w : report.warnings) std::fprintf(stderr, "voxbreast: warning: %s\n", w.c_str());
+  std::printf("wrote %s/summary.json\nwrote %s/result.h5\n", o.out.c_str(), o.out.c_str());
+  if (report.image_outputs) std::printf("wrote DVF, warped CT and fields on the CT grid in %s/\n", o.out.c_str());
+  if (report.mesh_outputs) std::printf("wrote surface meshes (.vtp, .stl, .ply) and lattice.vtu in %s/\n", o.out.c_str());
   return 0;
 }
 

@@ -15,5 +15,6 @@ Command add_info(CLI::App& app);
 Command add_simulate(CLI::App& app);
 Command add_bench(CLI::App& app);
 Command add_phantom(CLI::App& app);
+Command add_sweep(CLI::App& app);
 
 }  // namespace vb::app

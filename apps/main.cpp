@@ -3,6 +3,7 @@
 // Usage:
 //   voxbreast info
 //   voxbreast simulate data-samples/breast_phantom.toml --out out/phantom
+//   voxbreast sweep data-samples/phantom/scene.toml --vary gravity.posture=prone,supine --out out/sweep
 //   voxbreast bench --quick --out out/bench
 // Every subcommand has --help. Errors print one line naming the problem and exit non-zero.
 #include <CL/opencl.hpp>
@@ -18,7 +19,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string(vb::config::version) + " (" + vb::config::git_commit + ")");
   app.require_subcommand(1);
   const vb::app::Command commands[] = {vb::app::add_info(app), vb::app::add_simulate(app),
-                                       vb::app::add_bench(app), vb::app::add_phantom(app)};
+                                       vb::app::add_bench(app), vb::app::add_phantom(app),
+                                       vb::app::add_sweep(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -25,6 +25,13 @@ void Progress::update(double fraction, const std::string& text) {
   drawn_ = true;
 }
 
+void Progress::print_above(const std::string& line) {
+  if (enabled_ && drawn_) std::fprintf(stderr, "\r\033[K");
+  std::fputs(line.c_str(), stdout);
+  std::fflush(stdout);
+  drawn_ = false;  // redraw at once on the next update
+}
+
 void Progress::finish() {
   if (enabled_ && drawn_) std::fprintf(stderr, "\n");
   drawn_ = false;

@@ -12,6 +12,9 @@ class Progress {
   /// fraction in [0, 1]; text is appended after the bar. Redraws at most 10 times a second.
   void update(double fraction, const std::string& text);
   void finish();
+  /// Prints `line` (with its newline) to stdout above the bar, which is drawn again on the
+  /// next update.
+  void print_above(const std::string& line);
 
  private:
   bool enabled_;

@@ -19,6 +19,7 @@
 #include "engine/material/default_materials.hpp"
 #include "engine/material/hyperelastic.hpp"
 #include "engine/loads/posture.hpp"
+#include "io/did_you_mean.hpp"
 
 namespace vb {
 namespace {
@@ -56,32 +57,6 @@ std::string joined(const Keys& words) {
   std::string s;
   for (std::string_view w : words) s += (s.empty() ? "" : ", ") + std::string(w);
   return s;
-}
-
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1] ? 1 : 0)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
-/// "did you mean 'x'?" for the closest candidate within edit distance 2, else empty.
-std::string did_you_mean(std::string_view word, const Keys& candidates) {
-  std::string_view best;
-  std::size_t best_distance = 3;
-  for (std::string_view c : candidates) {
-    const std::size_t d = edit_distance(word, c);
-    if (d < best_distance) best = c, best_distance = d;
-  }
-  return best.empty() ? std::string() : "did you mean '" + std::string(best) + "'?";
 }
 
 /// Hint for a value outside a fixed set: a close match if there is one, and the whole set.
@@ -831,6 +806,11 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
   check_labels(scene, source_name);
   scene.source_text = text;
   return scene;
+}
+
+const std::vector<std::string>& scene_path_keys() {
+  static const std::vector<std::string> keys = {"model.image", "model.labels"};  // as resolve_paths
+  return keys;
 }
 
 Scene parse_scene_file(const std::string& path) {

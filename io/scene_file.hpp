@@ -3,6 +3,7 @@
 /// range are vb::Error naming the file, line and dotted key, so a typo never silently changes
 /// physics. The format is documented in docs/SCENE.md.
 #include <string>
+#include <vector>
 
 #include "engine/scene/scene.hpp"
 
@@ -15,5 +16,9 @@ Scene parse_scene_file(const std::string& path);
 /// Parses scene text; `source_name` (e.g. the file name) is used in error locations.
 /// Scene::source_text is `text`; Scene::source_path is left empty.
 Scene parse_scene_text(const std::string& text, const std::string& source_name);
+
+/// Dotted keys whose values are file paths, relative to the scene file's folder when relative
+/// (parse_scene_file resolves them): "model.image", "model.labels".
+const std::vector<std::string>& scene_path_keys();
 
 }  // namespace vb

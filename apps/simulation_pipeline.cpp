@@ -1,0 +1,52 @@
+#include "apps/simulation_pipeline.hpp"
+
+#include <mutex>
+
+#include "apps/image_outputs.hpp"
+#include "apps/mesh_outputs.hpp"
+#include "io/atomic_file.hpp"
+#include "io/hdf5_result.hpp"
+#include "io/json_summary.hpp"
+
+namespace vb::app {
+namespace {
+
+/// Held while reading inputs and writing outputs: Debian's HDF5 is built without thread safety.
+std::mutex& file_io_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+}  // namespace
+
+SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const std::string& out_dir,
+                                const SimulationOptions& options) {
+  std::unique_lock io(file_io_mutex());
+  const PreparedModel model = prepare_model(scene);
+  io.unlock();
+  Simulator sim(scene, model.lattice, model.elements, cl);
+  if (options.on_start) options.on_start(model, sim);
+  const RunOutput result = run_simulation(scene, model.lattice, model.elements, sim, options.on_progress);
+
+  SimulationReport report;
+  report.summary = result.summary;
+  report.warnings = model.warnings;
+  io.lock();
+  nlohmann::json summary = summary_to_json(result.summary, scene);
+  if (options.full_outputs) {
+    write_result_h5(out_dir + "/result.h5", model.lattice, scene, result.state, result.frames, result.summary);
+    if (model.ct) {
+      summary["image_outputs"] = write_image_outputs(out_dir, scene, model.lattice, *model.ct, result.state);
+      report.image_outputs = true;
+    }
+    if (scene.output.surfaces) {
+      summary["mesh_outputs"] = write_mesh_outputs(out_dir, model.lattice, result.state, result.frames);
+      report.mesh_outputs = true;
+    }
+  }
+  if (model.ct) summary["warnings"] = model.warnings;
+  write_text_atomically(out_dir + "/summary.json", summary.dump(2) + "\n");
+  return report;
+}
+
+}  // namespace vb::app

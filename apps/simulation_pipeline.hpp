@@ -1,0 +1,36 @@
+#pragma once
+/// One run of a scene, from the model to the files: what `simulate` does, and what `sweep` does
+/// for each case.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "apps/simulation_setup.hpp"
+#include "engine/sim/opencl_runtime.hpp"
+#include "engine/sim/run.hpp"
+
+namespace vb::app {
+
+struct SimulationOptions {
+  /// true: summary.json, result.h5 and the image outputs and meshes the scene asks for;
+  /// false: summary.json only (sweeps, where the numbers are what counts).
+  bool full_outputs = true;
+  /// Called once the model is built and the simulator is ready, before the run.
+  std::function<void(const PreparedModel&, const Simulator&)> on_start;
+  std::function<void(const RunProgress&)> on_progress;
+};
+
+struct SimulationReport {
+  RunSummary summary;
+  std::vector<std::string> warnings;  ///< e.g. DICOM slice gaps accepted with allow_gaps
+  bool image_outputs = false;         ///< DVF, warped CT and fields written (CT models)
+  bool mesh_outputs = false;          ///< surface meshes and lattice written
+};
+
+/// Builds the scene's model, runs it on `cl` and writes the outputs into `out_dir` (which must
+/// exist), summary.json last. Safe to call from several threads at once, each with its own
+/// context: the file readers and writers that are not thread-safe (HDF5, DCMTK) take turns.
+SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const std::string& out_dir,
+                                const SimulationOptions& options);
+
+}  // namespace vb::app
