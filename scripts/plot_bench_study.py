@@ -82,20 +82,23 @@ def main(out_dir, prefix, title):
         ax.loglog(float(r["elements"]), float(r["steps_per_s"]), "o" if r["integrator"] == "heun" else "^",
                   color=LAW_COLOURS.get(r["law"], "k"), alpha=0.6,
                   markerfacecolor="none" if r["precision"] == "double" else LAW_COLOURS.get(r["law"], "k"))
+    handles = [plt.Line2D([], [], color=c, marker="o", ls="", label=l) for l, c in LAW_COLOURS.items()]
+    handles += [plt.Line2D([], [], color="gray", marker="^", ls="", label="symplectic Euler"),
+                plt.Line2D([], [], color="gray", marker="o", markerfacecolor="none", ls="", label="double (hollow)")]
     throughput = os.path.join(out_dir, "throughput.csv")
     if os.path.exists(throughput):
         series = {}
         for r in csv.DictReader(open(throughput)):
-            series.setdefault(f'cubes: {r["law"]}, {r["integrator"]}, {r["precision"]}', []).append(
+            series.setdefault((r["law"], r["integrator"], r["precision"]), []).append(
                 (int(r["elements"]), float(r["steps_per_s"])))
-        for key, pts in sorted(series.items()):
+        for (law, integrator, precision), pts in sorted(series.items()):
             pts.sort()
-            ax.loglog([p[0] for p in pts], [p[1] for p in pts], "-", lw=1, label=key)
-        ax.legend(fontsize=7)
-    handles = [plt.Line2D([], [], color=c, marker="o", ls="", label=l) for l, c in LAW_COLOURS.items()]
-    handles += [plt.Line2D([], [], color="gray", marker="^", ls="", label="symplectic Euler"),
-                plt.Line2D([], [], color="gray", marker="o", markerfacecolor="none", ls="", label="double (hollow)")]
-    ax.add_artist(ax.legend(handles=handles, fontsize=8, loc="lower left"))
+            style = "--" if integrator != "heun" else ":" if precision == "double" else "-"
+            ax.loglog([p[0] for p in pts], [p[1] for p in pts], style, lw=1, color=LAW_COLOURS.get(law, "k"))
+        handles += [plt.Line2D([], [], color="gray", ls="-", label="cubes (--sizes): Heun float"),
+                    plt.Line2D([], [], color="gray", ls="--", label="cubes: Euler float"),
+                    plt.Line2D([], [], color="gray", ls=":", label="cubes: Heun double")]
+    ax.legend(handles=handles, fontsize=8, loc="lower left")
     ax.set_xlabel("elements")
     ax.set_ylabel("steps / s (checks included)")
     ax.set_title(f"{title}: steps/s against element count, every bench run")
