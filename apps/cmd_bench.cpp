@@ -1,179 +1,157 @@
-// voxbreast bench [--quick] --out DIR — steps/s of standard models on this device, and the
-// device's copy bandwidth measured in the same run. Writes bench.json and bench.csv.
-//   voxbreast bench --quick --out out/bench
+// voxbreast bench [--quick] --out DIR — speed against accuracy: standard scenes run to equilibrium
+// over the knobs users turn (law, integrator, precision, resolution, time step, volume
+// constraint), each measured against its scene's reference solution; plus steps/s of cube models
+// against the device's copy bandwidth (--sizes). Writes bench.json, bench.csv (and
+// throughput.csv). Design, reference and error measures: docs/BENCHMARKS.md.
+//   voxbreast bench --quick --out out/bench --phantom data-samples/phantom/scene.toml
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
+#include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <sstream>
+#include <set>
 
+#include "apps/bench_throughput.hpp"
 #include "apps/commands.hpp"
-#include "engine/lattice/lattice.hpp"
-#include "engine/lattice/voxelise.hpp"
-#include "engine/sim/simulator.hpp"
+#include "engine/bench/bench_knobs.hpp"
+#include "engine/bench/bench_table.hpp"
+#include "engine/bench/standard_study.hpp"
 #include "io/atomic_file.hpp"
 #include "voxbreast/config.hpp"
 
 namespace vb::app {
 namespace {
 
+const char* kDefaultPhantom = "data-samples/phantom/scene.toml";
+
 struct BenchOptions {
-  std::string out, device;
-  bool quick = false;
-  std::vector<int> sizes;  ///< block edge lengths in elements
-  std::vector<std::string> laws{"linear"};  ///< extra laws timed with Heun + float
+  std::string out, device, phantom;
+  bool quick = false, large = false, no_study = false, dry_run = false;
+  std::vector<int> sizes;  ///< throughput blocks (edge lengths in elements)
+  std::vector<std::string> laws, integrators, scenes;
 };
 
-struct BenchCase {
-  std::string name;
-  int edge = 0;
-  Integrator integrator = Integrator::Heun;
-  Precision precision = Precision::Float;
-  std::string law = "linear";
-};
+std::string utc_date() {
+  const std::time_t now = std::time(nullptr);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%d", std::gmtime(&now));
+  return text;
+}
 
-/// A cube of `edge`³ adipose elements, base held, under gravity: the standard linear block.
-Scene block_scene(const BenchCase& c) {
-  Scene s;
-  const double h = 0.002;
-  ShapeSpec box;
-  box.kind = ShapeSpec::Kind::Box;
-  box.min_m = Vec3::Zero();
-  box.max_m = Vec3::Constant(c.edge * h);
-  box.label = "adipose";
-  s.model.spacing_m = h;
-  s.model.shapes.push_back(box);
-  MaterialSpec m;
-  m.name = "adipose";
-  m.youngs_modulus_pa = 3000;
-  m.law = c.law;
-  if (c.law == "ogden") {  // a two-term Ogden tissue with μ₀ = 1.8 kPa
-    m.ogden_mu_pa = {1200, -300};
-    m.ogden_alpha = {4, -2};
+/// One progress line per run.
+void print_row(std::size_t index, std::size_t total, const bench::CaseResult& r) {
+  const bench::BenchCase& c = r.knobs;
+  std::printf("[%3zu/%zu] %-13s %-11s %-16s %-6s d%d dt×%-4g %-6s %9zu el  ", index, total, c.scene.c_str(),
+              c.law.c_str(), c.integrator.c_str(), bench::precision_name(c.precision), c.downsample, c.dt_factor,
+              c.part == "reference" ? "REF" : c.volume ? "vol" : "", r.elements);
+  if (r.status == "unstable" || r.status == "failed") {
+    std::printf("%s: %s\n", r.status == "unstable" ? "UNSTABLE" : "FAILED", r.message.c_str());
+  } else {
+    std::printf("%8lld steps %8.2f s %9.0f steps/s  err max %.2e rms %.2e mm  dV %+.3f%%%s\n", (long long)r.steps,
+                r.wall_s, r.seconds_per_step > 0 ? 1 / r.seconds_per_step : 0.0, 1e3 * r.error_max_m,
+                1e3 * r.error_rms_m, 100 * r.volume_change, r.status == "ok" ? "" : "  (not converged)");
   }
-  if (c.law == "biphasic") {  // the validation's biphasic springs (docs/VALIDATION.md)
-    m.cubic = 20;
-    m.critical_strain = 0.1;
+  std::fflush(stdout);
+}
+
+nlohmann::json describe_scenes(const bench::StudyPlan& plan) {
+  nlohmann::json scenes = nlohmann::json::array();
+  for (const bench::BenchScene& s : plan.scenes) {
+    nlohmann::json elements = nlohmann::json::object();
+    std::set<int> levels;
+    for (const bench::BenchCase& c : plan.cases)
+      if (c.scene == s.name) levels.insert(c.downsample);
+    for (int d : levels) elements[std::to_string(d)] = build_lattice(s.volume, d).element_count();
+    nlohmann::json j = {{"name", s.name}, {"spacing_mm", 1e3 * s.volume.spacing_m}, {"elements_by_downsample", elements},
+                        {"equilibrium_tolerance", s.scene.stop.equilibrium}};
+    if (s.column) j["closed_form_sag_mm"] = 1e3 * s.column->sag_m();
+    scenes.push_back(j);
+    std::printf("scene %-13s %.2f mm:", s.name.c_str(), 1e3 * s.volume.spacing_m);
+    for (auto& [d, n] : elements.items()) std::printf("  downsample %s → %zu elements", d.c_str(), n.get<std::size_t>());
+    std::printf("\n");
   }
-  m.poisson_ratio = 0.45;
-  s.materials["adipose"] = m;
-  s.solver.integrator = c.integrator;
-  s.solver.precision = c.precision;
-  s.solver.damping_per_s = 5;
-  s.gravity.active = true;
-  s.gravity.acceleration_m_s2 = Vec3(0, 0, -9.80665);
-  AnchorSpec base;
-  base.name = "base";
-  base.kind = AnchorSpec::Kind::HalfSpace;
-  base.point_m = Vec3(0, 0, h);
-  base.normal = Vec3(0, 0, -1);
-  s.anchors.push_back(base);
-  return s;
+  return scenes;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-/// Steps per second, timed over enough steps to last about `target_s`.
-double time_steps(Simulator& sim, double target_s) {
-  sim.advance(3);
-  sim.check();  // warm-up, includes any lazy compilation
-  std::int64_t steps = 4;
-  for (;;) {
-    const auto t0 = std::chrono::steady_clock::now();
-    sim.advance(steps);
-    sim.context().queue.finish();
-    const double t = seconds_since(t0);
-    if (t >= target_s || steps >= (1 << 22)) return double(steps) / t;
-    steps = std::int64_t(std::ceil(double(steps) * std::min(8.0, 1.2 * target_s / std::max(t, 1e-6))));
-  }
-}
-
-/// Achievable device bandwidth (bytes/s): read + write of a large buffer.
-double copy_bandwidth(const ClContext& cl, std::size_t bytes) {
-  cl::Program p = build_program(cl, {"common.cl", "bandwidth.cl"}, "", "-DVB_DOUBLE=0");
-  cl::Kernel k(p, "copy_bandwidth");
-  const std::size_t n = bytes / 16;
-  cl::Buffer a(cl.context, CL_MEM_READ_WRITE, n * 16), b(cl.context, CL_MEM_READ_WRITE, n * 16);
-  cl.queue.enqueueFillBuffer(a, cl_float(1), 0, n * 16);
-  k.setArg(0, a); k.setArg(1, b); k.setArg(2, cl_uint(n));
-  const cl::NDRange global((n + 255) / 256 * 256);
-  cl.queue.enqueueNDRangeKernel(k, cl::NullRange, global);
-  cl.queue.finish();
-  const int reps = 10;
-  const auto t0 = std::chrono::steady_clock::now();
-  for (int r = 0; r < reps; ++r) cl.queue.enqueueNDRangeKernel(k, cl::NullRange, global);
-  cl.queue.finish();
-  return 2.0 * double(n * 16) * reps / seconds_since(t0);
-}
-
-/// Bytes a Heun step must move per element, counting each element's own state once per stage
-/// (neighbour reads are served from cache): stage 1 reads u, v, E, cell, grid and writes ũ, ṽ;
-/// stage 2 reads u, v, ũ, ṽ, E, cell, grid and writes u, v. Hyperelastic tissues add, per
-/// stage, the stress pass (reads u, cell, grid, tissue; writes F and Q: 6 vectors) and the
-/// gather's read of the element's own F and Q and tissue.
-double heun_bytes_per_element(std::size_t real_size, bool hyperelastic) {
-  const double vec = 4.0 * double(real_size), scalar = double(real_size), idx = 4.0;
-  const double springs = (2 * vec + scalar + 2 * idx + 2 * vec) + (4 * vec + scalar + 2 * idx + 2 * vec);
-  const double stress_pass = (vec + 2 * idx + 1 + 6 * vec) + (6 * vec + 1);
-  return springs + (hyperelastic ? 2 * stress_pass : 0.0);
-}
-
-int run_bench(const BenchOptions& o) {
+int run_bench(BenchOptions o) {
+  const auto start = std::chrono::steady_clock::now();
   ensure_output_dir(o.out);
-  const ClContext cl(select_device(o.device));
-  std::vector<int> sizes = o.sizes;
-  if (sizes.empty()) sizes = {33, 115};  // 35,937 and 1,520,875 elements
-  const double target_s = o.quick ? 0.5 : 2.0;
-  const double bandwidth = copy_bandwidth(cl, std::min<std::size_t>(cl.info.max_allocation_bytes / 2, o.quick ? 64u << 20 : 512u << 20));
-  std::printf("device: %s (%s)\ncopy bandwidth: %.1f GB/s\n", cl.info.name.c_str(), cl.info.platform.c_str(), bandwidth / 1e9);
+  if (o.phantom.empty()) {
+    if (std::filesystem::exists(kDefaultPhantom)) o.phantom = kDefaultPhantom;
+    else std::printf("note: %s not found; phantom scenes left out (give --phantom)\n", kDefaultPhantom);
+  }
+  const DeviceInfo device = select_device(o.device);
+  std::printf("device: %s (%s)\n", device.name.c_str(), device.platform.c_str());
 
-  std::vector<BenchCase> cases;
-  for (int edge : sizes) {
-    cases.push_back({"block", edge, Integrator::Heun, Precision::Float});
-    if (!o.quick) {
-      cases.push_back({"block", edge, Integrator::SymplecticEuler, Precision::Float});
-      if (cl.info.fp64) cases.push_back({"block", edge, Integrator::Heun, Precision::Double});
+  nlohmann::json doc = {{"device", device.name}, {"platform", device.platform}, {"driver", device.driver},
+                        {"fp64", device.fp64}, {"quick", o.quick}, {"date", utc_date()},
+                        {"voxbreast_version", config::version}, {"git_commit", config::git_commit}};
+  std::string study_csv = bench::csv_header();
+  std::size_t failures = 0;
+  // Rewritten after every run, so that a run cut short (a device time limit) keeps what it did.
+  const auto write_outputs = [&] {
+    doc["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    write_text_atomically(o.out + "/bench.json", doc.dump(2) + "\n");
+    if (!o.no_study) write_text_atomically(o.out + "/bench.csv", study_csv);
+  };
+  std::unique_ptr<ClContext> cl;
+  // The cubes first: they are short, and kept when a long study is cut off by a time limit.
+  if (!o.dry_run && (!o.sizes.empty() || (!o.quick && o.no_study))) {
+    if (!cl) cl = std::make_unique<ClContext>(device);
+    ThroughputOptions t;
+    t.sizes = o.sizes.empty() ? std::vector<int>{33, 115} : o.sizes;  // 35,937 and 1,520,875 elements
+    t.quick = o.quick;
+    if (!o.laws.empty()) t.laws = o.laws;
+    const ThroughputResult tr = run_throughput(*cl, t);
+    doc["copy_bandwidth_gb_s"] = tr.copy_bandwidth_gb_s;
+    doc["throughput"] = tr.rows;
+    write_text_atomically(o.out + "/throughput.csv", tr.csv);
+    std::printf("wrote %s/throughput.csv\n", o.out.c_str());
+    write_outputs();
+  }
+  if (!o.no_study) {
+    bench::PlanOptions plan_options;
+    plan_options.quick = o.quick;
+    plan_options.large = o.large || (device.is_gpu && !o.quick);
+    plan_options.phantom_scene = o.phantom;
+    plan_options.scenes = o.scenes;
+    plan_options.laws = o.laws;
+    plan_options.integrators = o.integrators;
+    bench::StudyPlan plan = bench::standard_plan(plan_options);
+    doc["scenes"] = describe_scenes(plan);
+    doc["reference"] = {{"integrator", "heun"}, {"precision", "double"}, {"downsample", 1},
+                        {"dt_factor", plan.settings.reference_dt_factor},
+                        {"tolerance_factor", plan.settings.reference_tolerance_factor}};
+    std::set<std::string> reference_keys;
+    for (const bench::BenchCase& c : plan.cases) reference_keys.insert(c.reference_key());
+    const std::size_t total = plan.cases.size() + reference_keys.size();
+    std::printf("%zu runs: %zu cases and %zu reference solutions\n", total, plan.cases.size(), reference_keys.size());
+    if (o.dry_run) {
+      for (const bench::BenchCase& c : plan.cases) std::printf("  %-10s %s\n", c.part.c_str(), c.knobs().c_str());
+      return 0;
     }
-    for (const std::string& law : o.laws)
-      if (law != "linear") cases.push_back({"block", edge, Integrator::Heun, Precision::Float, law});
+    if (!cl) cl = std::make_unique<ClContext>(device);
+    bench::TradeStudy study(*cl, plan.settings);
+    for (bench::BenchScene& s : plan.scenes) study.add_scene(std::move(s));
+    for (const bench::BenchCase& c : plan.cases) study.expect(c);
+    doc["results"] = nlohmann::json::array();
+    std::size_t index = 0;
+    for (const bench::BenchCase& c : plan.cases) {
+      for (const bench::CaseResult& r : study.run(c)) {
+        print_row(++index, total, r);
+        failures += r.status == "failed";
+        doc["results"].push_back(bench::row_json(r));
+        study_csv += bench::csv_row(r);
+      }
+      write_outputs();
+    }
   }
-  nlohmann::json rows = nlohmann::json::array();
-  std::ostringstream csv;
-  csv << "model,elements,law,integrator,precision,steps_per_s,ns_per_element_step,bytes_per_element_step,"
-         "effective_bandwidth_gb_s,fraction_of_copy_bandwidth,device_bytes_per_element\n";
-  for (const BenchCase& c : cases) {
-    const Scene scene = block_scene(c);
-    const Lattice lattice = build_lattice(voxelise_shapes(scene));
-    const ElementArrays el = make_element_arrays(scene, lattice);
-    Simulator sim(scene, lattice, el, cl);
-    const double sps = time_steps(sim, target_s);
-    const std::size_t n = lattice.element_count();
-    const std::size_t real_size = c.precision == Precision::Double ? 8 : 4;
-    const bool heun = c.integrator == Integrator::Heun;
-    const bool hyper = c.law != "linear";
-    const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, hyper);
-    const double effective = bytes * double(n) * sps;
-    const char* integ = heun ? "heun" : "symplectic_euler";
-    const char* prec = c.precision == Precision::Double ? "double" : "float";
-    std::printf("%-6s %9zu elements  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
-                c.name.c_str(), n, c.law.c_str(), integ, prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
-    rows.push_back({{"model", c.name}, {"elements", n}, {"law", c.law}, {"integrator", integ}, {"precision", prec},
-                    {"steps_per_s", sps}, {"bytes_per_element_step", bytes}, {"effective_bandwidth_gb_s", effective / 1e9},
-                    {"fraction_of_copy_bandwidth", effective / bandwidth},
-                    {"device_bytes_per_element", double(sim.device_bytes()) / double(n)}});
-    csv << c.name << "," << n << "," << c.law << "," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
-        << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
-        << "\n";
-  }
-  nlohmann::json doc = {{"device", cl.info.name}, {"platform", cl.info.platform}, {"driver", cl.info.driver},
-                        {"copy_bandwidth_gb_s", bandwidth / 1e9}, {"quick", o.quick},
-                        {"voxbreast_version", config::version}, {"git_commit", config::git_commit}, {"results", rows}};
-  write_text_atomically(o.out + "/bench.json", doc.dump(2) + "\n");
-  write_text_atomically(o.out + "/bench.csv", csv.str());
-  std::printf("wrote %s/bench.json\nwrote %s/bench.csv\n", o.out.c_str(), o.out.c_str());
+  write_outputs();
+  std::printf("wrote %s/bench.json%s (%.0f s)\n", o.out.c_str(), o.no_study ? "" : " and bench.csv",
+              doc["wall_s"].get<double>());
+  if (failures) std::printf("%zu runs failed (see 'message' in bench.csv)\n", failures);
   return 0;
 }
 
@@ -181,13 +159,22 @@ int run_bench(const BenchOptions& o) {
 
 Command add_bench(CLI::App& app) {
   auto o = std::make_shared<BenchOptions>();
-  auto* sub = app.add_subcommand("bench", "Measure steps/s of standard models and the device bandwidth");
+  auto* sub = app.add_subcommand("bench", "Speed against accuracy over laws, integrators, precision, resolution, "
+                                          "time step and volume constraint; steps/s of cube models");
   sub->add_option("--out,-o", o->out, "output folder")->required();
   sub->add_option("--device,-d", o->device, "OpenCL device: gpu, cpu, an index or a name");
-  sub->add_flag("--quick", o->quick, "short timings, Heun + float only");
-  sub->add_option("--sizes", o->sizes, "block edge lengths in elements (default 33 115)")->check(CLI::Range(2, 1000));
-  sub->add_option("--laws", o->laws, "material laws to time (linear, biphasic, neo-hookean, ogden; default linear)")
-      ->check(CLI::IsMember({"linear", "biphasic", "neo-hookean", "ogden"}));
+  sub->add_flag("--quick", o->quick, "the CI-sized study (under 2 minutes on 2 CPU cores)");
+  sub->add_option("--phantom", o->phantom, std::string("scene.toml of the breast phantom (default ") + kDefaultPhantom + ")")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--scenes", o->scenes, "only these scenes: column, phantom, phantom_large");
+  sub->add_flag("--large", o->large, "add phantom_large (~1.5M elements; on by default on a GPU without --quick)");
+  sub->add_option("--laws", o->laws, "material laws of the grid (linear, biphasic, neo-hookean, ogden; default all, --quick all but ogden)")
+      ->check(CLI::IsMember(bench::law_names()));
+  sub->add_option("--integrators", o->integrators, "only these integrators")->check(CLI::IsMember(bench::integrator_names()));
+  sub->add_flag("--no-study", o->no_study, "skip the speed/accuracy study (throughput only)");
+  sub->add_option("--sizes", o->sizes, "throughput: time cubes of these edge lengths in elements (e.g. 33 115)")
+      ->check(CLI::Range(2, 1000));
+  sub->add_flag("--dry-run", o->dry_run, "list the scenes and cases without running them");
   return {sub, [o] { return run_bench(*o); }};
 }
 

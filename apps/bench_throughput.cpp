@@ -1,0 +1,164 @@
+#include "apps/bench_throughput.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "engine/lattice/lattice.hpp"
+#include "engine/lattice/voxelise.hpp"
+#include "engine/sim/simulator.hpp"
+
+namespace vb::app {
+namespace {
+
+struct BenchCase {
+  std::string name;
+  int edge = 0;
+  Integrator integrator = Integrator::Heun;
+  Precision precision = Precision::Float;
+  std::string law = "linear";
+};
+
+/// A cube of `edge`³ adipose elements, base held, under gravity: the standard linear block.
+Scene block_scene(const BenchCase& c) {
+  Scene s;
+  const double h = 0.002;
+  ShapeSpec box;
+  box.kind = ShapeSpec::Kind::Box;
+  box.min_m = Vec3::Zero();
+  box.max_m = Vec3::Constant(c.edge * h);
+  box.label = "adipose";
+  s.model.spacing_m = h;
+  s.model.shapes.push_back(box);
+  MaterialSpec m;
+  m.name = "adipose";
+  m.youngs_modulus_pa = 3000;
+  m.law = c.law;
+  if (c.law == "ogden") {  // a two-term Ogden tissue with μ₀ = 1.8 kPa
+    m.ogden_mu_pa = {1200, -300};
+    m.ogden_alpha = {4, -2};
+  }
+  if (c.law == "biphasic") {  // the validation's biphasic springs (docs/VALIDATION.md)
+    m.cubic = 20;
+    m.critical_strain = 0.1;
+  }
+  m.poisson_ratio = 0.45;
+  s.materials["adipose"] = m;
+  s.solver.integrator = c.integrator;
+  s.solver.precision = c.precision;
+  s.solver.damping_per_s = 5;
+  s.gravity.active = true;
+  s.gravity.acceleration_m_s2 = Vec3(0, 0, -9.80665);
+  AnchorSpec base;
+  base.name = "base";
+  base.kind = AnchorSpec::Kind::HalfSpace;
+  base.point_m = Vec3(0, 0, h);
+  base.normal = Vec3(0, 0, -1);
+  s.anchors.push_back(base);
+  return s;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Steps per second, timed over enough steps to last about `target_s`.
+double time_steps(Simulator& sim, double target_s) {
+  sim.advance(3);
+  sim.check();  // warm-up, includes any lazy compilation
+  std::int64_t steps = 4;
+  for (;;) {
+    const auto t0 = std::chrono::steady_clock::now();
+    sim.advance(steps);
+    sim.context().queue.finish();
+    const double t = seconds_since(t0);
+    if (t >= target_s || steps >= (1 << 22)) return double(steps) / t;
+    steps = std::int64_t(std::ceil(double(steps) * std::min(8.0, 1.2 * target_s / std::max(t, 1e-6))));
+  }
+}
+
+/// Achievable device bandwidth (bytes/s): read + write of a large buffer.
+double copy_bandwidth(const ClContext& cl, std::size_t bytes) {
+  cl::Program p = build_program(cl, {"common.cl", "bandwidth.cl"}, "", "-DVB_DOUBLE=0");
+  cl::Kernel k(p, "copy_bandwidth");
+  const std::size_t n = bytes / 16;
+  cl::Buffer a(cl.context, CL_MEM_READ_WRITE, n * 16), b(cl.context, CL_MEM_READ_WRITE, n * 16);
+  cl.queue.enqueueFillBuffer(a, cl_float(1), 0, n * 16);
+  k.setArg(0, a); k.setArg(1, b); k.setArg(2, cl_uint(n));
+  const cl::NDRange global((n + 255) / 256 * 256);
+  cl.queue.enqueueNDRangeKernel(k, cl::NullRange, global);
+  cl.queue.finish();
+  const int reps = 10;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int r = 0; r < reps; ++r) cl.queue.enqueueNDRangeKernel(k, cl::NullRange, global);
+  cl.queue.finish();
+  return 2.0 * double(n * 16) * reps / seconds_since(t0);
+}
+
+/// Bytes a Heun step must move per element, counting each element's own state once per stage
+/// (neighbour reads are served from cache): stage 1 reads u, v, E, cell, grid and writes ũ, ṽ;
+/// stage 2 reads u, v, ũ, ṽ, E, cell, grid and writes u, v. Hyperelastic tissues add, per
+/// stage, the stress pass (reads u, cell, grid, tissue; writes F and Q: 6 vectors) and the
+/// gather's read of the element's own F and Q and tissue.
+double heun_bytes_per_element(std::size_t real_size, bool hyperelastic) {
+  const double vec = 4.0 * double(real_size), scalar = double(real_size), idx = 4.0;
+  const double springs = (2 * vec + scalar + 2 * idx + 2 * vec) + (4 * vec + scalar + 2 * idx + 2 * vec);
+  const double stress_pass = (vec + 2 * idx + 1 + 6 * vec) + (6 * vec + 1);
+  return springs + (hyperelastic ? 2 * stress_pass : 0.0);
+}
+
+}  // namespace
+
+ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o) {
+  ThroughputResult result;
+  const std::vector<int>& sizes = o.sizes;
+  const double target_s = o.quick ? 0.5 : 2.0;
+  const double bandwidth = copy_bandwidth(cl, std::min<std::size_t>(cl.info.max_allocation_bytes / 2, o.quick ? 64u << 20 : 512u << 20));
+  result.copy_bandwidth_gb_s = bandwidth / 1e9;
+  std::printf("copy bandwidth: %.1f GB/s\n", bandwidth / 1e9);
+
+  std::vector<BenchCase> cases;
+  for (int edge : sizes) {
+    cases.push_back({"block", edge, Integrator::Heun, Precision::Float});
+    if (!o.quick) {
+      cases.push_back({"block", edge, Integrator::SymplecticEuler, Precision::Float});
+      if (cl.info.fp64) cases.push_back({"block", edge, Integrator::Heun, Precision::Double});
+    }
+    for (const std::string& law : o.laws)
+      if (law != "linear") cases.push_back({"block", edge, Integrator::Heun, Precision::Float, law});
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  std::ostringstream csv;
+  csv << "model,elements,law,integrator,precision,steps_per_s,ns_per_element_step,bytes_per_element_step,"
+         "effective_bandwidth_gb_s,fraction_of_copy_bandwidth,device_bytes_per_element\n";
+  for (const BenchCase& c : cases) {
+    const Scene scene = block_scene(c);
+    const Lattice lattice = build_lattice(voxelise_shapes(scene));
+    const ElementArrays el = make_element_arrays(scene, lattice);
+    Simulator sim(scene, lattice, el, cl);
+    const double sps = time_steps(sim, target_s);
+    const std::size_t n = lattice.element_count();
+    const std::size_t real_size = c.precision == Precision::Double ? 8 : 4;
+    const bool heun = c.integrator == Integrator::Heun;
+    const bool hyper = c.law != "linear";
+    const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, hyper);
+    const double effective = bytes * double(n) * sps;
+    const char* integ = heun ? "heun" : "symplectic_euler";
+    const char* prec = c.precision == Precision::Double ? "double" : "float";
+    std::printf("%-6s %9zu elements  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
+                c.name.c_str(), n, c.law.c_str(), integ, prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
+    rows.push_back({{"model", c.name}, {"elements", n}, {"law", c.law}, {"integrator", integ}, {"precision", prec},
+                    {"steps_per_s", sps}, {"bytes_per_element_step", bytes}, {"effective_bandwidth_gb_s", effective / 1e9},
+                    {"fraction_of_copy_bandwidth", effective / bandwidth},
+                    {"device_bytes_per_element", double(sim.device_bytes()) / double(n)}});
+    csv << c.name << "," << n << "," << c.law << "," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
+        << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
+        << "\n";
+  }
+  result.rows = rows;
+  result.csv = csv.str();
+  return result;
+}
+
+}  // namespace vb::app

@@ -1,0 +1,27 @@
+#pragma once
+/// Throughput part of `voxbreast bench`: steps/s of cube models of given sizes, as a fraction of
+/// the device's copy bandwidth measured in the same run (docs/BENCHMARKS.md, "Throughput").
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "engine/sim/opencl_runtime.hpp"
+
+namespace vb::app {
+
+struct ThroughputOptions {
+  std::vector<int> sizes;                   ///< block edge lengths in elements
+  std::vector<std::string> laws{"linear"};  ///< laws timed with Heun + float
+  bool quick = false;                       ///< 0.5 s per timing, Heun + float only
+};
+
+struct ThroughputResult {
+  double copy_bandwidth_gb_s = 0;
+  nlohmann::json rows = nlohmann::json::array();
+  std::string csv;  ///< throughput.csv
+};
+
+/// Times every block; prints one line per block.
+ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& options);
+
+}  // namespace vb::app

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The full speed/accuracy study and the cube throughput on a GPU, in one device call (~5 min on an
+# H200; results are rewritten after every run, so a call cut short keeps what it did).
+#   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
+#   device: bash scripts/bench_gpu.sh            (run tool, carry [".device-pkgs"]; writes $OUT/bench)
+#   here:   bash scripts/bench_gpu.sh plot FETCHED/bench h200   # docs/results/ and docs/img/ files
+# Extra bench options go in $BENCH_ARGS, e.g. BENCH_ARGS="--scenes phantom_large --laws neo-hookean".
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+
+if [[ "${1:-}" == "plot" ]]; then
+  dir=${2:?folder with bench.csv}
+  name=${3:-h200}
+  /usr/bin/python3 tests/apps/check_bench.py "$dir" || echo "check_bench found problems (see above)"
+  cp "$dir/bench.csv" "docs/results/bench_study_$name.csv"
+  cp "$dir/bench.json" "docs/results/bench_study_$name.json"
+  [[ -f "$dir/throughput.csv" ]] && cp "$dir/throughput.csv" "docs/results/bench_$name.csv"
+  /usr/bin/python3 scripts/plot_bench_study.py "$dir" "docs/img/bench_study_$name" "$name"
+  [[ -f "$dir/throughput.csv" ]] && /usr/bin/python3 scripts/plot_bench.py "$dir/throughput.csv" "docs/img/bench_scaling_$name.png" "$name"
+  exit 0
+fi
+
+out=${OUT:?run on the device machine, where \$OUT is the folder that comes back}/bench
+mkdir -p "$out"
+bash scripts/gpu_run.sh run voxbreast info >"$out/device.txt" 2>&1 || true
+# Full study (column, phantom, ~1.5M-element phantom) and the cube throughput series.
+# shellcheck disable=SC2086
+bash scripts/gpu_run.sh run voxbreast bench --device gpu --out "$out" --phantom data-samples/phantom/scene.toml \
+  --sizes 22 33 50 80 115 160 ${BENCH_ARGS:-} 2>&1 | tee "$out/bench.log"
+if command -v python3 >/dev/null; then python3 tests/apps/check_bench.py "$out" | tail -20; fi
