@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 
 #include "engine/error.hpp"
 #include "engine/image/image_lattice.hpp"
@@ -39,7 +40,7 @@ BenchScene column_scene(int nxy, int nz, double h) {
   base.normal = Vec3(0, 0, -1);
   s.anchors.push_back(base);
   const double length = nz * h;
-  const double omega1 = M_PI / (2 * length) * std::sqrt(E / rho);  // first axial mode of the column
+  const double omega1 = std::numbers::pi / (2 * length) * std::sqrt(E / rho);  // first axial mode of the column
   s.solver.damping_per_s = 2 * omega1;
   s.solver.dashpot_ratio = 0.1;
   s.stop.equilibrium = 1e-5;
