@@ -16,6 +16,7 @@ struct IntegratorSetting {
 const IntegratorSetting kIntegrators[] = {
     {"symplectic_euler", [](SolverSpec& s) { s.integrator = Integrator::SymplecticEuler; }},
     {"heun", [](SolverSpec& s) { s.integrator = Integrator::Heun; }},
+    {"relaxation", [](SolverSpec& s) { s.integrator = Integrator::Relaxation, s.dt_safety = 0.9; }},
 };
 
 std::string joined(const std::vector<std::string>& names) {
