@@ -1,17 +1,20 @@
-// voxbreast simulate SCENE.toml --out DIR — runs a scene and writes summary.json and result.h5.
+// voxbreast simulate SCENE.toml --out DIR — runs a scene and writes summary.json, metrics.csv and result.h5.
 //   voxbreast simulate data-samples/breast_phantom.toml --out out/phantom
 #include <cstdio>
 #include <memory>
 
 #include "apps/commands.hpp"
+#include "apps/device_mesh_outputs.hpp"
 #include "apps/image_outputs.hpp"
 #include "apps/mesh_outputs.hpp"
 #include "apps/progress.hpp"
 #include "apps/simulation_setup.hpp"
 #include "engine/sim/run.hpp"
+#include "engine/study/positioning_metrics.hpp"
 #include "io/atomic_file.hpp"
 #include "io/hdf5_result.hpp"
 #include "io/json_summary.hpp"
+#include "io/metrics_csv.hpp"
 
 namespace vb::app {
 namespace {
@@ -43,21 +46,35 @@ int run_simulate(const SimulateOptions& o) {
   });
   bar.finish();
 
-  const std::string h5 = o.out + "/result.h5", json = o.out + "/summary.json";
+  const std::string h5 = o.out + "/result.h5", json = o.out + "/summary.json", csv = o.out + "/metrics.csv";
   write_result_h5(h5, model.lattice, scene, result.state, result.frames, result.summary);
   nlohmann::json summary = summary_to_json(result.summary, scene);
+  const PositioningMetrics metrics =
+      compute_positioning_metrics(scene, model.lattice, model.elements, result.summary, result.state);
+  summary["positioning"] = positioning_to_json(metrics);
+  write_metrics_csv(csv, result.summary, metrics);
   if (model.ct) {
     summary["image_outputs"] = write_image_outputs(o.out, scene, model.lattice, *model.ct, result.state);
     summary["warnings"] = model.warnings;
   }
-  if (scene.output.surfaces) summary["mesh_outputs"] = write_mesh_outputs(o.out, model.lattice, result.state, result.frames);
+  if (scene.output.surfaces) {
+    summary["mesh_outputs"] = write_mesh_outputs(o.out, model.lattice, result.state, result.frames);
+    for (const auto& file : write_device_meshes(o.out, scene, result.summary.simulated_time_s, result.frames))
+      summary["mesh_outputs"]["files"].push_back(file);
+  }
   write_text_atomically(json, summary.dump(2) + "\n");
   const RunSummary& s = result.summary;
   std::printf("%s after %lld steps (%.4g s simulated, %.1f s wall, %.0f steps/s); max displacement %.3f mm\n",
               s.converged ? "equilibrium reached" : ("stopped at " + s.stop_reason).c_str(), (long long)s.steps,
               s.simulated_time_s, s.wall_time_s, s.steps_per_second, 1e3 * s.max_displacement_m);
   for (const std::string& w : model.warnings) std::fprintf(stderr, "voxbreast: warning: %s\n", w.c_str());
-  std::printf("wrote %s\nwrote %s\n", json.c_str(), h5.c_str());
+  for (const TorusResult& t : s.tori)
+    std::printf("torus %s: force %.4g N, %lld contact elements, peak pressure %.4g Pa\n", t.name.c_str(),
+                t.force_n.norm(), (long long)t.contact_elements, t.peak_pressure_pa);
+  if (metrics.tumour)
+    std::printf("tumour '%s' centroid moved %.3f mm\n", metrics.tumour->tissue.c_str(),
+                1e3 * metrics.tumour->displacement_m().norm());
+  std::printf("wrote %s\nwrote %s\nwrote %s\n", json.c_str(), csv.c_str(), h5.c_str());
   if (model.ct) std::printf("wrote DVF, warped CT and fields on the CT grid in %s/\n", o.out.c_str());
   if (scene.output.surfaces) std::printf("wrote surface meshes (.vtp, .stl, .ply) and lattice.vtu in %s/\n", o.out.c_str());
   return 0;

@@ -4,14 +4,18 @@
 //     corrector u' = u + dt/2·(v + ṽ), v' = v + dt/2·(a(u, v) + a(ũ, ṽ)) = (v + ṽ)/2 + dt/2·a(ũ, ṽ)
 //     (a(u, v) is recovered from ṽ, so no force buffer is stored).
 
+// `grip` collects the friction of the tori the element touches (kernels/device_contact.cl).
 inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                          VB_LATTICE_PARAMS, global const real* indenters, real t) {
+                          VB_LATTICE_PARAMS, global const real* indenters, real t, torus_grip* grip) {
   real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
 #if VB_GLOBAL_DAMPING
   f -= damping * xyz0(vi) / ui.w;
 #endif
 #if VB_INDENTERS
   contact_constrain_all(&f, rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui), indenters, t, h);
+#endif
+#if VB_TORI
+  torus_constrain_all(&f, rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui), indenters, t, h, grip);
 #endif
   return f * ui.w;
 }
@@ -20,6 +24,9 @@ inline void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_o
                          real4 origin, real h, global const real* indenters, real t) {
 #if VB_INDENTERS
   contact_project_all(un, vn, rest_position(cell_of[e], sy, sz, origin, h), indenters, t, h);
+#endif
+#if VB_TORI
+  torus_project_all(un, vn, rest_position(cell_of[e], sy, sz, origin, h), indenters, t, h);
 #endif
 }
 
@@ -32,10 +39,11 @@ inline void explicit_stage(global const real4* u, global const real4* v, global 
   if (e >= n) return;
   real4 ui = u[e], vi = v[e];
   if (ui.w != 0) {
-    const real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force);
-    if (symplectic) vi += dt * a;
+    torus_grip grip = {0};
+    const real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force, &grip);
+    if (symplectic) vi += dt * a, torus_apply_grip(&vi, grip, dt * ui.w);
     ui += dt * xyz0(vi);
-    if (!symplectic) vi += dt * a;
+    if (!symplectic) vi += dt * a, torus_apply_grip(&vi, grip, dt * ui.w);
     finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, indenters, t_project);
   }
   u_out[e] = ui;
@@ -62,8 +70,10 @@ kernel void heun_correct(global real4* u, global real4* v, global const real4* u
   real4 ui = u[e];
   if (ui.w == 0) return;
   const real4 vi = v[e], up = u_pred[e], vp = v_pred[e];
-  const real4 a = acceleration(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t_force);
+  torus_grip grip = {0};
+  const real4 a = acceleration(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t_force, &grip);
   real4 vn = xyz0((vi + vp) * (real)0.5 + (real)0.5 * dt * a);
+  torus_apply_grip(&vn, grip, (real)0.5 * dt * ui.w);  // the predictor's half reaches vn through ṽ
   ui += (real)0.5 * dt * xyz0(vi + vp);
   finish_stage(e, &ui, &vn, cell_of, sy, sz, origin, h, indenters, t_project);
   u[e] = ui;
