@@ -75,8 +75,12 @@ int run_simulate(const SimulateOptions& o) {
     std::printf("tumour '%s' centroid moved %.3f mm\n", metrics.tumour->tissue.c_str(),
                 1e3 * metrics.tumour->displacement_m().norm());
   std::printf("wrote %s\nwrote %s\nwrote %s\n", json.c_str(), csv.c_str(), h5.c_str());
-  if (model.ct) std::printf("wrote DVF, warped CT and fields on the CT grid in %s/\n", o.out.c_str());
-  if (scene.output.surfaces) std::printf("wrote surface meshes (.vtp, .stl, .ply) and lattice.vtu in %s/\n", o.out.c_str());
+  const OutputSpec& out = scene.output;
+  if (model.ct && (out.dvf || out.warped_ct || out.warped_ct_dicom || out.fields))
+    std::printf("wrote DVF, warped CT and fields on the CT grid in %s/\n", o.out.c_str());
+  if (scene.output.surfaces)
+    std::printf("wrote surface meshes (.vtp, .stl, .ply)%s and lattice.vtu in %s/\n",
+                scene.tori.empty() ? "" : ", device meshes", o.out.c_str());
   return 0;
 }
 

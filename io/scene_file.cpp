@@ -33,8 +33,6 @@ struct LaterKey {
   std::string_view hint;
 };
 
-constexpr std::string_view kLaterVersion = "it comes in a later version";
-
 /// A name accepted for a string-valued key, the value it maps to, and (for `kind` keys) the keys
 /// a table of that kind may hold.
 template <class E>

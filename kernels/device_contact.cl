@@ -16,8 +16,9 @@
 // through memory) costs PoCL more than the arithmetic.
 #define VB_INLINE inline __attribute__((always_inline))
 
-// Friction of an element touching a torus during one stage: μ·|f_n| (N) the contact can resist
-// tangentially, the contact normal and the surface's velocity there. grip_n = 0: no friction.
+// Friction of an element touching a torus during one stage: μ·|f_n| the contact can resist
+// tangentially (N, or m/s² when the constraint works on the acceleration f/m), the contact
+// normal and the surface's velocity there. grip_n = 0: no friction.
 typedef struct {
   real grip_n;
   real4 normal;
@@ -78,8 +79,9 @@ VB_INLINE real torus_distance(real4 x, global const real* table, global const re
 }
 
 // Frictionless unilateral contact of an element within REAL_CONTACT_TOL·h of the tube surface (or
-// inside): the torus carries the inward normal part of f, which is removed from f and returned
-// (the force on the torus, N). With friction, μ·|f_n| is added to the grip.
+// inside): the torus carries the inward normal part of f (a force, or the acceleration f/m: the
+// same constraint), which is removed from f and returned (the force on the torus, N, for a
+// force). With friction, μ·|f_n| is added to the grip.
 VB_INLINE real4 torus_constrain(real4* f, real4 x, global const real* table, global const real* tor, real t, real h,
                                 torus_grip* grip) {
   const real4 rad = torus_radii(table, tor, t);
@@ -118,15 +120,15 @@ VB_INLINE void torus_project_all(real4* ui, real4* vi, real4 X, global const rea
 }
 #endif
 
-// Coulomb friction at the velocity level: the stage's tangential impulse is at most grip·dt, so
-// the tangential velocity relative to the surface drops by at most grip·dt·w (w = 1/m). An
-// element whose tangential force stays within μ·|f_n| is stopped (sticks); beyond, it slides with
-// friction μ·|f_n| against its motion. `dt_w` is the stage's dt·w.
-VB_INLINE void torus_apply_grip(real4* v, torus_grip g, real dt_w) {
+// Coulomb friction at the velocity level: the stage's tangential impulse per unit mass is at most
+// μ·|a_n|·dt, so the tangential velocity relative to the surface drops by at most that. An element
+// whose tangential force stays within μ·|f_n| is stopped (sticks); beyond, it slides with friction
+// μ·|f_n| against its motion. `g` was collected on the acceleration; `dt` is the stage's.
+VB_INLINE void torus_apply_grip(real4* v, torus_grip g, real dt) {
 #if VB_FRICTION
   const real4 rel = xyz0(*v - g.surface_v);
   const real4 vt = rel - dot3(rel, g.normal) * g.normal;
-  const real speed = length(vt), stop = g.grip_n * dt_w;  // no grip: stop = 0, nothing removed
+  const real speed = length(vt), stop = g.grip_n * dt;  // no grip: stop = 0, nothing removed
   *v -= (speed > stop ? stop / speed : (real)1) * vt;
 #endif
 }

@@ -143,6 +143,14 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   check_groups_ = (n_ + wg - 1) / wg;
   global_ = cl::NDRange(check_groups_ * wg);
   local_ = cl.info.is_gpu ? cl::NDRange(wg) : cl::NullRange;  // PoCL picks faster sizes itself
+  for (const TorusSpec& t : scene.tori)
+    for (const TorusKnot& k : t.schedule)
+      require(k.minor_radius_m >= lattice.spacing_m,
+              "torus '" + t.name + "' has a tube radius of " + std::to_string(k.minor_radius_m) +
+                  " m, thinner than the lattice spacing " + std::to_string(lattice.spacing_m) + " m",
+              "device.torus " + t.name + (t.line ? " (line " + std::to_string(t.line) + ")" : ""),
+              "contact is tested at element centres, so a thinner tube could pass between them: make the minor "
+              "radius at least one spacing, or refine the lattice");
   check_slots_ = kCheckBaseSlots + kCheckSlotsPerIndenter * int(scene.indenters.size()) +
                  kCheckSlotsPerTorus * int(scene.tori.size());
   const auto local_bytes = cl.info.device.getInfo<CL_DEVICE_LOCAL_MEM_SIZE>();

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "engine/device/torus.hpp"
+#include "engine/error.hpp"
 #include "engine/sim/run.hpp"
 #include "engine/study/positioning_metrics.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
@@ -109,6 +110,13 @@ TEST(TorusContact, TorusAndPlateIndenterShareTheLoad) {
               ring_force.z(), expected.z());
   EXPECT_LT((ring_force - expected).norm(), 1e-3 * expected.norm())
       << "ring " << ring_force.transpose() << " expected " << expected.transpose();
+}
+
+TEST(TorusContact, TubeThinnerThanTheSpacingIsRefused) {
+  Scene s = block_in_ring();
+  s.tori[0].schedule = {{0.0, 0.0015, 0.010}};  // r = 1.5 mm < h = 2 mm: could slip between elements
+  const auto m = test::make_model(s);
+  EXPECT_THROW(Simulator(s, m.lattice, m.elements, test::cl_context()), Error);
 }
 
 /// A dome (hemisphere, radius 14 mm, 2 mm elements) on a held base slab (z ≤ 0), gravity towards

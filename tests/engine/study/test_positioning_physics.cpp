@@ -2,6 +2,7 @@
 // slab held by the paper's sphere anchor) with a stiff tumour, run under several postures.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <map>
 
 #include "engine/loads/posture.hpp"
@@ -68,6 +69,9 @@ TEST(GravityFlip, TumourMovesWithGravityAndAwayFromTheChestWallWhenProne) {
     EXPECT_GT(d.norm(), 1e-4) << posture << ": the tumour barely moved";
     EXPECT_GT(d.dot(down), 0.9 * d.norm()) << posture << ": tumour moved " << d.transpose() << ", gravity along "
                                            << down.transpose();
+    std::printf("%s: tumour moved %.4f %.4f %.4f mm; chest wall distance %.4f → %.4f mm, mean %.4f → %.4f mm\n", posture,
+                1e3 * d.x(), 1e3 * d.y(), 1e3 * d.z(), 1e3 * *m.chest_wall->tumour_rest_m, 1e3 * *m.chest_wall->tumour_final_m,
+                1e3 * m.chest_wall->mean_rest_m, 1e3 * m.chest_wall->mean_final_m);
     runs[posture] = m;
   }
   // Supine presses the tumour towards the chest wall; prone lets it hang away.
