@@ -1,4 +1,4 @@
-// voxbreast simulate SCENE.toml --out DIR — runs a scene and writes summary.json and result.h5.
+// voxbreast simulate SCENE.toml --out DIR — runs a scene and writes summary.json, metrics.csv and result.h5.
 //   voxbreast simulate data-samples/breast_phantom.toml --out out/phantom
 #include <cstdio>
 #include <memory>
@@ -45,9 +45,18 @@ int run_simulate(const SimulateOptions& o) {
               s.converged ? "equilibrium reached" : ("stopped at " + s.stop_reason).c_str(), (long long)s.steps,
               s.simulated_time_s, s.wall_time_s, s.steps_per_second, 1e3 * s.max_displacement_m);
   for (const std::string& w : report.warnings) std::fprintf(stderr, "voxbreast: warning: %s\n", w.c_str());
-  std::printf("wrote %s/summary.json\nwrote %s/result.h5\n", o.out.c_str(), o.out.c_str());
+  for (const TorusResult& t : s.tori)
+    std::printf("torus %s: force %.4g N, %lld contact elements, peak pressure %.4g Pa\n", t.name.c_str(),
+                t.force_n.norm(), (long long)t.contact_elements, t.peak_pressure_pa);
+  if (report.positioning.tumour)
+    std::printf("tumour '%s' centroid moved %.3f mm\n", report.positioning.tumour->tissue.c_str(),
+                1e3 * report.positioning.tumour->displacement_m().norm());
+  std::printf("wrote %s/summary.json\nwrote %s/metrics.csv\nwrote %s/result.h5\n", o.out.c_str(), o.out.c_str(),
+              o.out.c_str());
   if (report.image_outputs) std::printf("wrote DVF, warped CT and fields on the CT grid in %s/\n", o.out.c_str());
-  if (report.mesh_outputs) std::printf("wrote surface meshes (.vtp, .stl, .ply) and lattice.vtu in %s/\n", o.out.c_str());
+  if (report.mesh_outputs)
+    std::printf("wrote surface meshes (.vtp, .stl, .ply)%s and lattice.vtu in %s/\n",
+                scene.tori.empty() ? "" : ", device meshes", o.out.c_str());
   return 0;
 }
 

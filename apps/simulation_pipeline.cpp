@@ -2,11 +2,13 @@
 
 #include <mutex>
 
+#include "apps/device_mesh_outputs.hpp"
 #include "apps/image_outputs.hpp"
 #include "apps/mesh_outputs.hpp"
 #include "io/atomic_file.hpp"
 #include "io/hdf5_result.hpp"
 #include "io/json_summary.hpp"
+#include "io/metrics_csv.hpp"
 
 namespace vb::app {
 namespace {
@@ -33,6 +35,9 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
   report.warnings = model.warnings;
   io.lock();
   nlohmann::json summary = summary_to_json(result.summary, scene);
+  report.positioning = compute_positioning_metrics(scene, model.lattice, model.elements, result.summary, result.state);
+  summary["positioning"] = positioning_to_json(report.positioning);
+  write_metrics_csv(out_dir + "/metrics.csv", result.summary, report.positioning);
   if (options.full_outputs) {
     write_result_h5(out_dir + "/result.h5", model.lattice, scene, result.state, result.frames, result.summary);
     if (model.ct) {
@@ -41,6 +46,8 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
     }
     if (scene.output.surfaces) {
       summary["mesh_outputs"] = write_mesh_outputs(out_dir, model.lattice, result.state, result.frames);
+      for (const auto& file : write_device_meshes(out_dir, scene, result.summary.simulated_time_s, result.frames))
+        summary["mesh_outputs"]["files"].push_back(file);
       report.mesh_outputs = true;
     }
   }

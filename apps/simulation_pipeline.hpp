@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "apps/simulation_setup.hpp"
+#include "engine/study/positioning_metrics.hpp"
 #include "engine/sim/opencl_runtime.hpp"
 #include "engine/sim/run.hpp"
 
@@ -21,6 +22,7 @@ struct SimulationOptions {
 };
 
 struct SimulationReport {
+  PositioningMetrics positioning;  ///< tumour, chest wall, device contact, comfort (docs/POSITIONING.md)
   RunSummary summary;
   std::vector<std::string> warnings;  ///< e.g. DICOM slice gaps accepted with allow_gaps
   bool image_outputs = false;         ///< DVF, warped CT and fields written (CT models)

@@ -38,7 +38,60 @@ json indenters_to_json(const std::vector<IndenterResult>& indenters) {
   return out;
 }
 
+json tori_to_json(const std::vector<TorusResult>& tori) {
+  json out = json::array();
+  for (const auto& t : tori)
+    out.push_back({{"name", t.name},
+                   {"minor_radius_m", number(t.minor_radius_m)},
+                   {"major_radius_m", number(t.major_radius_m)},
+                   {"force_n", vec3(t.force_n)},
+                   {"force_norm_n", number(t.force_n.norm())},
+                   {"normal_force_sum_n", number(t.normal_force_sum_n)},
+                   {"contact_elements", t.contact_elements},
+                   {"contact_area_m2", number(t.contact_area_m2)},
+                   {"peak_pressure_pa", number(t.peak_pressure_pa)},
+                   {"mean_pressure_pa", number(t.mean_pressure_pa)},
+                   {"max_penetration_m", number(t.max_penetration_m)},
+                   {"max_penetration_during_run_m", number(t.max_penetration_run_m)}});
+  return out;
+}
+
+json optional_number(const std::optional<double>& x) { return x ? number(*x) : json(nullptr); }
+
 }  // namespace
+
+json positioning_to_json(const PositioningMetrics& m) {
+  json out = {{"volume_change_fraction", number(m.volume_change)},
+              {"surface_volume_change_fraction", number(m.surface_volume_change)},
+              {"comfort",
+               {{"peak_equivalent_strain", number(m.comfort.peak_equivalent_strain)},
+                {"p95_equivalent_strain", number(m.comfort.p95_equivalent_strain)},
+                {"peak_von_mises_stress_pa", number(m.comfort.peak_von_mises_pa)},
+                {"p95_von_mises_stress_pa", number(m.comfort.p95_von_mises_pa)}}},
+              {"tumour", nullptr},
+              {"chest_wall", nullptr}};
+  if (const auto& t = m.tumour) {
+    out["tumour"] = {{"tissue", t->tissue},
+                     {"elements", t->elements},
+                     {"rest_centroid_m", vec3(t->rest_centroid_m)},
+                     {"final_centroid_m", vec3(t->final_centroid_m)},
+                     {"displacement_m", vec3(t->displacement_m())},
+                     {"displacement_norm_m", number(t->displacement_m().norm())},
+                     {"target_m", t->target_m ? vec3(*t->target_m) : json(nullptr)},
+                     {"rest_target_distance_m", t->target_m ? number(t->rest_target_distance_m) : json(nullptr)},
+                     {"final_target_distance_m", t->target_m ? number(t->final_target_distance_m) : json(nullptr)}};
+  }
+  if (const auto& c = m.chest_wall) {
+    out["chest_wall"] = {{"anchor", c->anchor},
+                         {"tumour_distance_rest_m", optional_number(c->tumour_rest_m)},
+                         {"tumour_distance_final_m", optional_number(c->tumour_final_m)},
+                         {"mean_distance_rest_m", number(c->mean_rest_m)},
+                         {"mean_distance_final_m", number(c->mean_final_m)},
+                         {"max_distance_rest_m", number(c->max_rest_m)},
+                         {"max_distance_final_m", number(c->max_final_m)}};
+  }
+  return out;
+}
 
 json summary_to_json(const RunSummary& s, const Scene& scene) {
   return {
@@ -65,6 +118,7 @@ json summary_to_json(const RunSummary& s, const Scene& scene) {
       {"integrator", s.integrator},
       {"tracked", tracked_to_json(s.tracked)},
       {"indenters", indenters_to_json(s.indenters)},
+      {"immobilisation_device", {{"tori", tori_to_json(s.tori)}}},
   };
 }
 

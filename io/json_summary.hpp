@@ -5,11 +5,15 @@
 
 #include "engine/scene/scene.hpp"
 #include "engine/sim/run_result.hpp"
+#include "engine/study/positioning_metrics.hpp"
 
 namespace vb {
 
 /// Every field name carries its unit; non-finite numbers become null (JSON has no NaN).
 nlohmann::json summary_to_json(const RunSummary& summary, const Scene& scene);
+
+/// The `positioning` section of summary.json (docs/OUTPUTS.md); absent parts are null.
+nlohmann::json positioning_to_json(const PositioningMetrics& metrics);
 
 /// Writes summary_to_json() to `path` atomically (temporary file + rename); throws vb::Error.
 void write_summary_json(const std::string& path, const RunSummary& summary, const Scene& scene);

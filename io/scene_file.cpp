@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -32,8 +33,6 @@ struct LaterKey {
   std::string_view key;
   std::string_view hint;
 };
-
-constexpr std::string_view kLaterVersion = "it comes in a later version";
 
 /// A name accepted for a string-valued key, the value it maps to, and (for `kind` keys) the keys
 /// a table of that kind may hold.
@@ -675,6 +674,120 @@ IndenterSpec read_indenter(const Section& s) {
   return i;
 }
 
+// ---- the immobilisation device and positioning (docs/SCENE.md, [[device.torus]]) -------------
+
+/// `key = [[a, b, ...], ...]`: rows of `width` finite numbers (at least one row); absent → nullopt.
+std::optional<std::vector<std::vector<double>>> number_rows(const Section& s, std::string_view key, std::size_t width,
+                                                            const std::string& row_shape) {
+  const toml::node* node = s.find(key);
+  if (!node) return std::nullopt;
+  const toml::array* rows = node->as_array();
+  if (!rows || rows->empty()) s.fail(key, "expected an array of rows " + row_shape + ", got " + describe(*node));
+  std::vector<std::vector<double>> out;
+  for (std::size_t i = 0; i < rows->size(); ++i) {
+    const toml::array* row = rows->get(i)->as_array();
+    const std::string which = "row " + std::to_string(i + 1) + " ";
+    if (!row || row->size() != width)
+      s.fail(key, which + "must be " + row_shape + ", got " + describe(*rows->get(i)));
+    out.emplace_back();
+    for (const toml::node& n : *row) {
+      const std::optional<double> x = as_double(n);
+      if (!x || !std::isfinite(*x)) s.fail(key, which + "must hold finite numbers " + row_shape + ", got " + describe(n));
+      out.back().push_back(*x);
+    }
+  }
+  return out;
+}
+
+/// Inflation knots from minor_radius (constant), inflate = [[t, r], ...] (with major_radius) or
+/// inner_outer = [[t, inner, outer], ...]; exactly one of the three.
+std::vector<TorusKnot> read_torus_schedule(const Section& s) {
+  const bool has_minor = s.find("minor_radius"), has_inflate = s.find("inflate"), has_io = s.find("inner_outer");
+  if (int(has_minor) + int(has_inflate) + int(has_io) != 1)
+    s.fail(has_io ? "inner_outer" : has_inflate ? "inflate" : "minor_radius",
+           has_minor || has_inflate || has_io ? "give only one of 'minor_radius', 'inflate' and 'inner_outer'"
+                                              : "missing the tube size",
+           "minor_radius = r (m), or inflate = [[t_s, r_m], ...], or inner_outer = [[t_s, inner_m, outer_m], ...]");
+  std::vector<TorusKnot> knots;
+  if (has_io) {
+    if (s.find("major_radius")) s.fail("major_radius", "'inner_outer' sets the major radius already", "remove 'major_radius'");
+    const auto rows = *number_rows(s, "inner_outer", 3, "[t_s, inner_m, outer_m]");
+    for (const auto& row : rows) {
+      if (!(row[1] > 0 && row[2] > row[1]))
+        s.fail("inner_outer", "at t = " + format_number(row[0]) + " s: need 0 < inner < outer, got inner " +
+                                  format_number(row[1]) + " m, outer " + format_number(row[2]) + " m");
+      knots.push_back({row[0], 0.5 * (row[2] - row[1]), 0.5 * (row[2] + row[1])});
+    }
+  } else {
+    const double major = s.required("major_radius", s.positive("major_radius"));
+    if (has_minor) {
+      knots.push_back({0.0, s.required("minor_radius", s.positive("minor_radius")), major});
+    } else {
+      const auto rows = *number_rows(s, "inflate", 2, "[t_s, minor_radius_m]");
+      for (const auto& row : rows) {
+        if (!(row[1] > 0)) s.fail("inflate", "at t = " + format_number(row[0]) + " s: the minor radius must be > 0");
+        knots.push_back({row[0], row[1], major});
+      }
+    }
+  }
+  const std::string key = has_io ? "inner_outer" : has_inflate ? "inflate" : "minor_radius";
+  for (std::size_t i = 0; i < knots.size(); ++i) {
+    const TorusKnot& k = knots[i];
+    if (k.time_s < 0) s.fail(key, "times must be ≥ 0 s, got " + format_number(k.time_s));
+    if (i > 0 && !(k.time_s > knots[i - 1].time_s))
+      s.fail(key, "times must increase strictly, got " + format_number(knots[i - 1].time_s) + " s then " +
+                      format_number(k.time_s) + " s");
+    if (!(k.minor_radius_m < k.major_radius_m))
+      s.fail(key, "the minor radius " + format_number(k.minor_radius_m) + " m must be smaller than the major radius " +
+                      format_number(k.major_radius_m) + " m" + (knots.size() > 1 ? " (at t = " + format_number(k.time_s) + " s)" : ""),
+             "a tube that reaches the axis is not a ring torus");
+  }
+  return knots;
+}
+
+TorusSpec read_torus(const Section& s, std::size_t index, const std::vector<TorusSpec>& earlier) {
+  s.check_keys({"name", "center", "axis", "major_radius", "minor_radius", "inflate", "inner_outer", "friction"});
+  TorusSpec t;
+  t.line = s.line();
+  t.name = s.text("name").value_or("torus_" + std::to_string(index + 1));
+  const auto bad_char = [](char c) { return !(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'); };
+  if (t.name.empty() || std::any_of(t.name.begin(), t.name.end(), bad_char))
+    s.fail("name", "must be letters, digits, '_' or '-' (it names the device mesh files)");
+  for (const TorusSpec& other : earlier)
+    if (other.name == t.name) s.fail("name", "duplicate torus name '" + t.name + "'", "first used at line " + std::to_string(other.line));
+  t.center_m = s.required("center", s.vec3("center"));
+  t.axis = s.required("axis", s.direction("axis"));
+  t.schedule = read_torus_schedule(s);
+  t.friction = s.non_negative("friction").value_or(0.0);
+  return t;
+}
+
+std::vector<TorusSpec> read_device(const Section& s) {
+  s.check_keys({"torus"});
+  std::vector<TorusSpec> tori;
+  for (const Section& t : s.tables("torus")) tori.push_back(read_torus(t, tori.size(), tori));
+  return tori;
+}
+
+PositioningSpec read_positioning(const Section& s, const std::vector<AnchorSpec>& anchors) {
+  s.check_keys({"tumour_tissue", "target", "chest_wall"});
+  PositioningSpec p;
+  p.line = s.line();
+  p.tumour_tissue = s.text("tumour_tissue").value_or("");
+  if (s.find("tumour_tissue") && p.tumour_tissue.empty()) s.fail("tumour_tissue", "must not be empty");
+  p.target_m = s.vec3("target");
+  p.chest_wall = s.text("chest_wall").value_or("");
+  if (s.find("chest_wall")) {
+    const auto it = std::find_if(anchors.begin(), anchors.end(), [&](const AnchorSpec& a) { return a.name == p.chest_wall; });
+    Keys names;
+    for (const AnchorSpec& a : anchors) names.push_back(a.name);
+    if (it == anchors.end()) s.fail("chest_wall", "names no [anchor." + p.chest_wall + "]", choice_hint(p.chest_wall, names));
+    if (it->kind == AnchorSpec::Kind::Box)
+      s.fail("chest_wall", "anchor '" + p.chest_wall + "' is a box", "the chest wall is a sphere or halfspace anchor");
+  }
+  return p;
+}
+
 std::vector<TrackSpec> read_tracks(const std::vector<Section>& sections) {
   std::vector<TrackSpec> tracks;
   for (const Section& s : sections) {
@@ -788,8 +901,8 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
   const toml::table root = parse_toml(text, source_name);
   const Section top(root, "", source_name);
   top.check_keys(
-      {"model", "materials", "solver", "gravity", "anchor", "indenter", "track", "stop", "output", "volume"},
-      {{"device", kLaterVersion}});
+      {"model", "materials", "solver", "gravity", "anchor", "indenter", "device", "positioning", "track", "stop",
+       "output", "volume"});
   Scene scene;
   scene.model = read_model(top.table_or_empty("model"));
   scene.materials = read_materials(top.table_or_empty("materials"));
@@ -799,6 +912,8 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
     scene.anchors.push_back(read_anchor(name, s));
   }
   for (const Section& s : top.tables("indenter")) scene.indenters.push_back(read_indenter(s));
+  if (const auto device = top.table("device")) scene.tori = read_device(*device);
+  if (const auto positioning = top.table("positioning")) scene.positioning = read_positioning(*positioning, scene.anchors);
   scene.tracks = read_tracks(top.tables("track"));
   scene.stop = read_stop(top.table_or_empty("stop"));
   scene.output = read_output(top.table_or_empty("output"), scene.model);

@@ -1,24 +1,75 @@
 // State check, run every `check_every` steps (never every step): per work-group reductions the
-// host finishes. Slots of `partial` per group (VB_CHECK_SLOTS = 5 + 4·VB_INDENTERS reals):
+// host finishes. Slots of `partial` per group (VB_CHECK_SLOTS = 5 + 4·VB_INDENTERS + 8·VB_TORI
+// + 4·VB_RELAX reals):
 //   0 max residual force |F| on free elements (N)   1 max speed (m/s; +inf if non-finite)
 //   2 kinetic energy (J)                            3 max |u| (m)
 //   4 non-finite elements
 //   5 + 4i .. 7 + 4i  force of the tissue on indenter i (N), 8 + 4i  its contact elements
+// `partial_arg` holds, per group, the element with the largest speed (first non-finite wins).
+// With VB_VOLUME the residual is that of the constrained problem: the pressure term p·g
+// (kernels/volume.cl, computed just before) is taken off the static force of surface elements.
+// With VB_TORI, 8 slots per torus follow from VB_TORUS_SLOT0: 0–2 force of the tissue on it (N),
+// 3 contact elements, 4 their contact area (m², per-element shares), 5 the sum of their normal
+// forces |f_n| (N), 6 peak contact pressure (Pa, max), 7 deepest penetration of a free element
+// into the tube (m, max).
 // With VB_RELAX (dynamic relaxation, kernels/relax.cl) four more sums follow: Rayleigh quotients,
 // each ≥ the lowest mode's ω², that the host sets the damping from (Underwood). One is of the
 // displacement u (the lattice force is zero at rest), one of the change Δu since the previous
 // check (stored in relax_prev with the lattice force then), which late in a relaxation is the
-// slowest mode itself. With R = 5 + 4·VB_INDENTERS:
+// slowest mode itself. With R = VB_RELAX_SLOT0 (after the tori's slots):
 //   R     uᵀKu = −Σ u·f_lattice(u)          R + 1  uᵀM̃u = Σ m̃|u|²
 //   R + 2 ΔuᵀKΔu = −Σ Δu·Δf_lattice         R + 3  ΔuᵀM̃Δu = Σ m̃|Δu|²
 // (J and kg·m²; exact for linear springs, secant/tangent-like for the other laws).
+#define VB_TORUS_SLOT0 (5 + 4 * VB_INDENTERS)
+#define VB_TORUS_SLOTS 8
+#define VB_RELAX_SLOT0 (VB_TORUS_SLOT0 + VB_TORUS_SLOTS * VB_TORI)
+#if VB_TORI
+#define VB_SLOT_SUM(s) ((s) == 2 || ((s) >= 4 && ((s) < VB_TORUS_SLOT0 || (s) >= VB_RELAX_SLOT0 || \
+                                                  ((s) - VB_TORUS_SLOT0) % VB_TORUS_SLOTS < 6)))
+#else
 #define VB_SLOT_SUM(s) ((s) == 2 || (s) >= 4)
+#endif
+
+#if VB_TORI
+// Contact of element x with torus i at the check: the carried force (normal and, with friction,
+// the tangential part up to μ·|f_n|) is removed from f; fills the torus's slots.
+VB_INLINE void torus_check(real4* f, real4 x, global const real* table, int i, real t, real h, real area,
+                        real* value) {
+  global const real* tor = torus_row(table, i);
+  real4 n, w;
+  const real dist = torus_distance(x, table, tor, t, &n, &w);
+  torus_grip grip = {0};
+  real4 carried = torus_constrain(f, x, table, tor, t, h, &grip);
+  const real fn = -dot3(carried, n);  // compressive normal force (N), ≥ 0
+#if VB_FRICTION
+  if (fn > 0 && tor[3] > 0) {
+    const real4 ft = *f - dot3(*f, n) * n;
+    const real size = length(ft), limit = tor[3] * fn;
+    const real4 held = size <= limit ? ft : ft * (limit / size);
+    *f -= held;
+    carried += held;
+  }
+#endif
+  real* slot = value + VB_TORUS_SLOT0 + VB_TORUS_SLOTS * i;
+  slot[0] = carried.x;
+  slot[1] = carried.y;
+  slot[2] = carried.z;
+  slot[3] = fn > 0 ? 1 : 0;
+  slot[4] = fn > 0 ? area : 0;
+  slot[5] = fn;
+  slot[6] = fn > 0 ? fn / area : 0;
+  slot[7] = fmax(-dist, (real)0);
+}
+#endif
 
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
 void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS,
                  VB_INDENTER_PARAMS, global real* partial, global int* partial_arg, uint n
 #if VB_VOLUME
                  , global const real4* volume_grad, global const real* volume_scalars
+#endif
+#if VB_TORI
+                 , global const real* contact_area  // per element: its share of the surface (m²)
 #endif
 #if VB_RELAX
                  , global const real* relax_scale, global real4* relax_prev
@@ -40,7 +91,7 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
     if (finite && ui.w != 0) {
       real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
 #if VB_RELAX
-      const int R = 5 + 4 * VB_INDENTERS;
+      const int R = VB_RELAX_SLOT0;
 #if VB_GRAVITY
       const real4 f_lattice = xyz0(f - xyz0(gravity) / ui.w);
 #else
@@ -66,6 +117,13 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
         value[6 + 4 * i] = reaction.y;
         value[7 + 4 * i] = reaction.z;
         value[8 + 4 * i] = dot3(reaction, reaction) > 0 ? 1 : 0;
+      }
+#endif
+#if VB_TORI
+      {
+        const real4 xt = rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui);
+        const real area = contact_area[e] > 0 ? contact_area[e] : h * h;
+        for (int i = 0; i < VB_TORI; ++i) torus_check(&f, xt, indenters, i, t_force, h, area, value);
       }
 #endif
       value[0] = length(xyz0(f));

@@ -7,7 +7,8 @@
 //   -DVB_BIPHASIC=0|1 biphasic-spring tissues present (kernels/lattice_forces.cl)
 //   -DVB_CHECK_WG=N   work-group size of the reduction kernel
 //   -DVB_VOLUME=0|1   volume-preservation constraint on (kernels/volume.cl)
-//   -DVB_RELAX=0|1    dynamic relaxation (kernels/relax.cl): two more check slots
+//   -DVB_RELAX=0|1    dynamic relaxation (kernels/relax.cl): four more check slots
+//   -DVB_TORI=count, -DVB_TORUS_BASE=N, -DVB_FRICTION=0|1  the torus device (kernels/device_contact.cl)
 // and prepends the lattice tables (VB_DIR, VB_DIR_LEN, VB_KAPPA) generated from the host's
 // single definition (engine/sim/kernel_tables.cpp).
 #if VB_DOUBLE
@@ -49,7 +50,8 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
 // 0–2 start (m), 3 radius (m; < 0 for a plate), 4–6 plate normal into the tissue, 8–10
 // velocity (m/s), 12 travel time (s), 13 contact: 0 push, 1 slide, 2 stick), the time forces are
 // evaluated at, and the time stage
-// positions are projected at. A 1-element placeholder when VB_INDENTERS is 0.
+// positions are projected at. A 1-row placeholder when VB_INDENTERS is 0. Torus rows and their
+// inflation knots follow from VB_TORUS_BASE (kernels/device_contact.cl): the rigid-obstacle table.
 #define VB_IND_STRIDE 16
 #define VB_INDENTER_PARAMS global const real *indenters, real t_force, real t_project
 #define VB_INDENTER_ARGS indenters, t_force, t_project

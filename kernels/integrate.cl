@@ -1,4 +1,7 @@
 // Time integrators. One work-item per element; held elements (u.w == 0) never move.
+// With VB_TORI the torus device (kernels/device_contact.cl) constrains each stage's acceleration
+// (a = f/m: removing its inward normal part removes the force's), applies friction to the new
+// velocity and projects the stage's end out of the tubes, after the indenters.
 //   symplectic Euler (main paper eq. 11):  v' = v + dt·a(u, v);  u' = u + dt·v'
 //   Heun (improved Euler, trapezium rule): predictor ũ = u + dt·v, ṽ = v + dt·a(u, v);
 //     corrector u' = u + dt/2·(v + ṽ), v' = v + dt/2·(a(u, v) + a(ũ, ṽ)) = (v + ṽ)/2 + dt/2·a(ũ, ṽ)
@@ -32,11 +35,25 @@ inline void explicit_stage(global const real4* u, global const real4* v, global 
   if (e >= n) return;
   real4 ui = u[e], vi = v[e];
   if (ui.w != 0) {
-    const real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force);
+    real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force);
+#if VB_TORI
+    const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
+    torus_grip grip = {0};
+    torus_constrain_all(&a, X + xyz0(ui), indenters, t_force, h, &grip);
+#endif
     if (symplectic) vi += dt * a;
+#if VB_TORI
+    if (symplectic) torus_apply_grip(&vi, grip, dt);
+#endif
     ui += dt * xyz0(vi);
     if (!symplectic) vi += dt * a;
+#if VB_TORI
+    if (!symplectic) torus_apply_grip(&vi, grip, dt);
+#endif
     finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, indenters, t_project);
+#if VB_TORI
+    torus_project_all(&ui, &vi, X, indenters, t_project, h);
+#endif
   }
   u_out[e] = ui;
   v_out[e] = vi;
@@ -62,10 +79,21 @@ kernel void heun_correct(global real4* u, global real4* v, global const real4* u
   real4 ui = u[e];
   if (ui.w == 0) return;
   const real4 vi = v[e], up = u_pred[e], vp = v_pred[e];
-  const real4 a = acceleration(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t_force);
+  real4 a = acceleration(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t_force);
+#if VB_TORI
+  const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
+  torus_grip grip = {0};
+  torus_constrain_all(&a, X + xyz0(up), indenters, t_force, h, &grip);
+#endif
   real4 vn = xyz0((vi + vp) * (real)0.5 + (real)0.5 * dt * a);
+#if VB_TORI
+  torus_apply_grip(&vn, grip, (real)0.5 * dt);  // the predictor's half reaches vn through ṽ
+#endif
   ui += (real)0.5 * dt * xyz0(vi + vp);
   finish_stage(e, &ui, &vn, cell_of, sy, sz, origin, h, indenters, t_project);
+#if VB_TORI
+  torus_project_all(&ui, &vn, X, indenters, t_project, h);
+#endif
   u[e] = ui;
   v[e] = vn;
 }

@@ -120,6 +120,34 @@ struct IndenterSpec {
   int line = 0;
 };
 
+/// One knot of a torus inflation schedule: the tube's radii at a time; between knots they change
+/// linearly, before the first and after the last they hold.
+struct TorusKnot {
+  double time_s = 0;
+  double minor_radius_m = 0;  ///< tube radius r (m)
+  double major_radius_m = 0;  ///< radius R of the tube's centre circle (m); r < R
+};
+
+/// Rigid inflatable torus of the immobilisation device ([[device.torus]], docs/SCENE.md): the
+/// points within r(t) of the circle of radius R(t) about `axis` through `center`. It pushes the
+/// elements it touches (unilateral, frictionless unless `friction` > 0: Coulomb).
+struct TorusSpec {
+  std::string name;
+  Vec3 center_m = Vec3::Zero();
+  Vec3 axis = Vec3::UnitZ();         ///< unit
+  std::vector<TorusKnot> schedule;   ///< ≥ 1 knots, strictly increasing times ≥ 0
+  double friction = 0;               ///< Coulomb coefficient μ (0: frictionless)
+  int line = 0;
+};
+
+/// What positioning metrics refer to ([positioning], docs/POSITIONING.md). Everything optional.
+struct PositioningSpec {
+  std::string tumour_tissue;           ///< tissue whose centroid is tracked; empty: "tumour" if present
+  std::optional<Vec3> target_m;        ///< planned tumour position (m)
+  std::string chest_wall;              ///< anchor standing for the chest wall; empty: the only sphere anchor
+  int line = 0;
+};
+
 struct TrackSpec {
   std::string name;
   Vec3 point_m = Vec3::Zero();
@@ -159,6 +187,8 @@ struct Scene {
   GravitySpec gravity;
   std::vector<AnchorSpec> anchors;
   std::vector<IndenterSpec> indenters;
+  std::vector<TorusSpec> tori;  ///< [[device.torus]]
+  PositioningSpec positioning;
   std::vector<TrackSpec> tracks;
   StopSpec stop;
   OutputSpec output;

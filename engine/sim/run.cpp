@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "engine/device/torus.hpp"
 #include "engine/error.hpp"
 #include "engine/results/element_measures.hpp"
 #include "engine/surface/enclosed_volume.hpp"
@@ -76,6 +77,27 @@ void require_no_inverted_element(const Lattice& lattice, const ElementArrays& el
               "or use a smaller solver.dt");
 }
 
+/// Device contact at a check: the latest values, and the deepest penetration so far.
+void record_tori(const Scene& scene, double t_s, const StateCheck& c, std::vector<TorusResult>& out) {
+  out.resize(scene.tori.size());
+  for (std::size_t i = 0; i < scene.tori.size(); ++i) {
+    TorusResult& r = out[i];
+    const TorusContactCheck& k = c.tori[i];
+    const TorusRadii radii = torus_radii(scene.tori[i], t_s);
+    r.name = scene.tori[i].name;
+    r.minor_radius_m = radii.minor_m;
+    r.major_radius_m = radii.major_m;
+    r.force_n = k.force_n;
+    r.contact_elements = k.contact_elements;
+    r.contact_area_m2 = k.contact_area_m2;
+    r.normal_force_sum_n = k.normal_force_sum_n;
+    r.mean_pressure_pa = k.contact_area_m2 > 0 ? k.normal_force_sum_n / k.contact_area_m2 : 0;
+    r.peak_pressure_pa = k.peak_pressure_pa;
+    r.max_penetration_m = k.max_penetration_m;
+    r.max_penetration_run_m = std::max(r.max_penetration_run_m, k.max_penetration_m);
+  }
+}
+
 }  // namespace
 
 std::pair<double, double> equilibrium_scales(const Lattice& lattice, const ElementArrays& el) {
@@ -110,6 +132,7 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
   double travel_end = 0;  // equilibrium only counts once every moving indenter has stopped
   for (const IndenterSpec& ind : scene.indenters)
     if (ind.velocity_m_s.squaredNorm() > 0) travel_end = std::max(travel_end, ind.travel_time_s);
+  for (const TorusSpec& t : scene.tori) travel_end = std::max(travel_end, torus_inflation_end_s(t));
   const std::int64_t check_every = std::max(1, scene.solver.check_every);
   const std::int64_t frames_every = scene.output.frames_every;
   std::int64_t max_steps = scene.stop.max_steps;
@@ -153,6 +176,7 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
       const Vec3& f = ir.reaction_force_n;
       ir.history.push_back({sim.time_s(), f.x(), f.y(), f.z(), travel});
     }
+    record_tori(scene, sim.time_s(), c, s.tori);
     if (progress) progress({sim.steps(), max_steps, sim.time_s(), s.final_residual, s.final_speed_ratio});
     // A relaxation's velocities are fictitious (scaled masses): its equilibrium is the residual's.
     const bool at_rest = s.final_speed_ratio <= tol || scene.solver.integrator == Integrator::Relaxation;

@@ -24,6 +24,20 @@ struct IndenterResult {
   std::vector<std::array<double, 5>> history;
 };
 
+/// One torus of the immobilisation device at the end of the run ([[device.torus]]).
+struct TorusResult {
+  std::string name;
+  double minor_radius_m = 0, major_radius_m = 0;  ///< at the final time
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();  ///< force the tissue exerts on it (N)
+  std::int64_t contact_elements = 0;
+  double contact_area_m2 = 0;     ///< surface-area shares of the contact elements
+  double normal_force_sum_n = 0;  ///< Σ |normal force| over the contact elements (N): the squeeze
+  double peak_pressure_pa = 0;    ///< largest element normal force over its area share
+  double mean_pressure_pa = 0;    ///< total normal force over the contact area
+  double max_penetration_m = 0;   ///< deepest free element inside the tube, final state
+  double max_penetration_run_m = 0;  ///< the same, largest over every check of the run
+};
+
 struct RunSummary {
   std::size_t elements = 0;
   std::size_t connections = 0;
@@ -48,6 +62,7 @@ struct RunSummary {
   std::string integrator;           ///< "symplectic_euler" | "heun"
   std::vector<TrackedPointResult> tracked;
   std::vector<IndenterResult> indenters;
+  std::vector<TorusResult> tori;
 };
 
 /// Final per-element state (n = element count; vectors are n×3 row-major).

@@ -4,16 +4,20 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/device/torus.hpp"
 #include "engine/error.hpp"
 #include "engine/sim/kernel_tables.hpp"
 #include "engine/surface/enclosed_volume.hpp"
+#include "engine/surface/surface_area.hpp"
 
 namespace vb {
 namespace {
 
 constexpr int kCheckWorkGroup = 128;
 constexpr int kCheckBaseSlots = 5, kCheckSlotsPerIndenter = 4;  // kernels/checks.cl
+constexpr int kCheckSlotsPerTorus = 8;                             // VB_TORUS_SLOTS
 constexpr int kIndenterStride = 16;                                // VB_IND_STRIDE
+constexpr int kTorusStride = 12;                                   // VB_TORUS_STRIDE
 // Kernel argument layout (kernels/common.cl): VB_LATTICE_PARAMS then VB_INDENTER_PARAMS.
 constexpr int kLatticeArgs = 15, kIndenterArgs = 3;
 constexpr int kStepLattice = 4;                              // step kernels: 4 state buffers first
@@ -143,9 +147,24 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   check_groups_ = (n_ + wg - 1) / wg;
   global_ = cl::NDRange(check_groups_ * wg);
   local_ = cl.info.is_gpu ? cl::NDRange(wg) : cl::NullRange;  // PoCL picks faster sizes itself
-  check_slots_ = kCheckBaseSlots + kCheckSlotsPerIndenter * int(scene.indenters.size()) + (relax_ ? 4 : 0);
+  for (const TorusSpec& t : scene.tori)
+    for (const TorusKnot& k : t.schedule)
+      require(k.minor_radius_m >= lattice.spacing_m,
+              "torus '" + t.name + "' has a tube radius of " + std::to_string(k.minor_radius_m) +
+                  " m, thinner than the lattice spacing " + std::to_string(lattice.spacing_m) + " m",
+              "device.torus " + t.name + (t.line ? " (line " + std::to_string(t.line) + ")" : ""),
+              "contact is tested at element centres, so a thinner tube could pass between them: make the minor "
+              "radius at least one spacing, or refine the lattice");
+  check_slots_ = kCheckBaseSlots + kCheckSlotsPerIndenter * int(scene.indenters.size()) +
+                 kCheckSlotsPerTorus * int(scene.tori.size()) + (relax_ ? 4 : 0);
+  const auto local_bytes = cl.info.device.getInfo<CL_DEVICE_LOCAL_MEM_SIZE>();
+  require(std::size_t(check_slots_) * kCheckWorkGroup * real_size_ + kCheckWorkGroup * sizeof(cl_int) <= local_bytes,
+          std::to_string(scene.indenters.size()) + " indenters and " + std::to_string(scene.tori.size()) +
+              " tori need more local memory in the check kernel than '" + cl.info.name + "' has (" +
+              std::to_string(local_bytes) + " bytes)",
+          "indenter, device.torus", "use fewer indenters or tori, or float precision");
   partial_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * check_slots_ * real_size_);
-  indenters_ = make_real_buffer(indenter_table());
+  indenters_ = make_real_buffer(obstacle_table());
   partial_arg_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * sizeof(cl_int));
 
   // Only the features this scene uses are compiled in.
@@ -165,7 +184,12 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_BIPHASIC=" + std::to_string(el.biphasic);
   options += " -DVB_CHECK_WG=" + std::to_string(kCheckWorkGroup);
   options += " -DVB_VOLUME=" + std::to_string(volume_);
-  std::vector<std::string> sources = {"common.cl", "hyperelastic.cl", "lattice_forces.cl", "integrate.cl"};
+  const bool friction = std::any_of(scene.tori.begin(), scene.tori.end(), [](const TorusSpec& t) { return t.friction > 0; });
+  options += " -DVB_TORI=" + std::to_string(scene.tori.size());
+  options += " -DVB_TORUS_BASE=" + std::to_string(torus_table_base());
+  options += " -DVB_FRICTION=" + std::to_string(friction);
+  std::vector<std::string> sources = {"common.cl", "hyperelastic.cl", "lattice_forces.cl", "device_contact.cl",
+                                      "integrate.cl"};
   if (volume_) sources.push_back("volume.cl");
   if (relax_) sources.push_back("relax.cl");
   sources.push_back("checks.cl");
@@ -213,14 +237,25 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   check_.setArg(kCheckIndenter + kIndenterArgs + 1, partial_arg_);
   check_.setArg(kCheckIndenter + kIndenterArgs + 2, cl_uint(n_));
   if (relax_) {
-    check_.setArg(kCheckVolume + (volume_ ? 2 : 0), relax_scale_);
+    const int relax_arg = kCheckVolume + (volume_ ? 2 : 0) + (scene.tori.empty() ? 0 : 1);
+    check_.setArg(relax_arg, relax_scale_);
     // u and the lattice force at the previous check; zero = the rest state, where both are zero
     std::vector<char> zeros(2 * 4 * real_size_ * n_, 0);
     relax_prev_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, zeros.size(), zeros.data());
-    check_.setArg(kCheckVolume + (volume_ ? 3 : 1), relax_prev_);
+    check_.setArg(relax_arg + 1, relax_prev_);
     set_real(relax_kernel_, kStepIndenter + kIndenterArgs + 3, damping_);
   }
   if (volume_) make_volume_buffers(surface_);
+  if (!scene.tori.empty()) make_contact_area_buffer();
+}
+
+void Simulator::make_contact_area_buffer() {
+  // Rest shares: contact happens on the surface, and a share changes little with the deformation.
+  const SurfaceMesh built = volume_ ? SurfaceMesh{} : build_surface(lattice_);
+  const SurfaceMesh& mesh = volume_ ? surface_ : built;
+  contact_area_host_ = element_surface_area_m2(mesh, element_positions_m(lattice_));
+  contact_area_ = make_real_buffer(contact_area_host_);
+  check_.setArg(kCheckVolume + (volume_ ? 2 : 0), contact_area_);
 }
 
 void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
@@ -407,9 +442,13 @@ Vec3 Simulator::indenter_position(std::size_t i, double t) const {
   return ind.start_m + ind.velocity_m_s * std::min(t, ind.travel_time_s);
 }
 
-std::vector<double> Simulator::indenter_table() const {
+std::size_t Simulator::torus_table_base() const {
+  return kIndenterStride * std::max<std::size_t>(1, scene_.indenters.size());
+}
+
+std::vector<double> Simulator::obstacle_table() const {
   // Rows in the lattice frame (kernels/common.cl, VB_INDENTER_PARAMS); a placeholder row if none.
-  std::vector<double> table(kIndenterStride * std::max<std::size_t>(1, scene_.indenters.size()), 0.0);
+  std::vector<double> table(torus_table_base(), 0.0);
   const Eigen::Matrix3d Rt = lattice_.rotation.transpose();
   for (std::size_t i = 0; i < scene_.indenters.size(); ++i) {
     const IndenterSpec& ind = scene_.indenters[i];
@@ -420,6 +459,31 @@ std::vector<double> Simulator::indenter_table() const {
     row[12] = std::isfinite(ind.travel_time_s) ? ind.travel_time_s : 1e300;
     row[13] = double(int(ind.contact));  // 0 push, 1 slide, 2 stick
   }
+  // Torus rows (kernels/device_contact.cl), then each torus's knots: time, minor and major
+  // radius, and for the segment to the next knot 1/span and the two rates (0 for the last).
+  const std::size_t knots_base = table.size() + kTorusStride * scene_.tori.size();
+  table.resize(knots_base, 0.0);
+  for (std::size_t i = 0; i < scene_.tori.size(); ++i) {
+    const TorusSpec& t = scene_.tori[i];
+    double* row = &table[torus_table_base() + kTorusStride * i];
+    const Vec3 centre = Rt * t.center_m, axis = Rt * t.axis, perpendicular = Rt * reference_perpendicular(t.axis);
+    for (int c = 0; c < 3; ++c) row[c] = centre[c], row[4 + c] = axis[c], row[8 + c] = perpendicular[c];
+    row[3] = t.friction;
+    row[7] = double(t.schedule.size());
+    row[11] = double(table.size());
+    for (std::size_t j = 0; j < t.schedule.size(); ++j) {
+      const TorusKnot& k = t.schedule[j];
+      double inverse_span = 0, minor_rate = 0, major_rate = 0;
+      if (j + 1 < t.schedule.size()) {
+        const TorusKnot& next = t.schedule[j + 1];
+        inverse_span = 1 / (next.time_s - k.time_s);
+        minor_rate = (next.minor_radius_m - k.minor_radius_m) * inverse_span;
+        major_rate = (next.major_radius_m - k.major_radius_m) * inverse_span;
+      }
+      table.insert(table.end(), {k.time_s, k.minor_radius_m, k.major_radius_m, inverse_span, minor_rate, major_rate});
+    }
+  }
+  require(table.size() < (1u << 24), "the device's inflation schedules are too long", "device.torus");  // exact in float
   return table;
 }
 
@@ -443,7 +507,7 @@ void Simulator::enqueue_check() const {
 }
 
 void Simulator::advance(std::int64_t steps) {
-  const bool indenter = !scene_.indenters.empty();
+  const bool indenter = !scene_.indenters.empty() || !scene_.tori.empty();  // obstacles that move in time
   const double dt = dt_.dt_s;
   for (std::int64_t s = 0; s < steps; ++s, ++steps_) {
     const double t0 = double(steps_) * dt, t1 = double(steps_ + 1) * dt;
@@ -495,6 +559,7 @@ StateCheck Simulator::check() {
   StateCheck c;
   c.indenter_force_n.assign(scene_.indenters.size(), Vec3::Zero());
   c.contact_elements.assign(scene_.indenters.size(), 0);
+  c.tori.assign(scene_.tori.size(), TorusContactCheck{});
   for (std::size_t g = 0; g < check_groups_; ++g) {
     const double* q = &p[g * check_slots_];
     c.max_residual_n = std::max(c.max_residual_n, q[0]);
@@ -509,6 +574,16 @@ StateCheck Simulator::check() {
       const double* r = q + kCheckBaseSlots + kCheckSlotsPerIndenter * i;
       c.indenter_force_n[i] += lattice_.rotation * Vec3(r[0], r[1], r[2]);
       c.contact_elements[i] += std::llround(r[3]);
+    }
+    for (std::size_t i = 0; i < scene_.tori.size(); ++i) {
+      const double* r = q + kCheckBaseSlots + kCheckSlotsPerIndenter * scene_.indenters.size() + kCheckSlotsPerTorus * i;
+      TorusContactCheck& t = c.tori[i];
+      t.force_n += lattice_.rotation * Vec3(r[0], r[1], r[2]);
+      t.contact_elements += std::llround(r[3]);
+      t.contact_area_m2 += r[4];
+      t.normal_force_sum_n += r[5];
+      t.peak_pressure_pa = std::max(t.peak_pressure_pa, r[6]);
+      t.max_penetration_m = std::max(t.max_penetration_m, r[7]);
     }
   }
   if (volume_) c.enclosed_volume_m3 = read_enclosed_volume_m3();

@@ -15,6 +15,16 @@
 
 namespace vb {
 
+/// Contact of one torus of the device at a check (kernels/checks.cl).
+struct TorusContactCheck {
+  Vec3 force_n = Vec3::Zero();        ///< force the tissue exerts on the torus (N, world frame)
+  std::int64_t contact_elements = 0;  ///< free elements it pushes
+  double contact_area_m2 = 0;         ///< their surface-area shares (engine/surface/surface_area.hpp)
+  double normal_force_sum_n = 0;      ///< Σ |normal force| over its contact elements (N)
+  double peak_pressure_pa = 0;        ///< largest normal force over area share of one element
+  double max_penetration_m = 0;       ///< deepest free element inside the tube (m)
+};
+
 /// Device-side reductions over the current state (see kernels/checks.cl).
 struct StateCheck {
   double max_residual_n = 0;      ///< largest net static force on a free element (N)
@@ -23,6 +33,7 @@ struct StateCheck {
   double max_displacement_m = 0;
   std::vector<Vec3> indenter_force_n;           ///< per indenter: force the tissue exerts on it (N)
   std::vector<std::int64_t> contact_elements;   ///< per indenter: elements touching it
+  std::vector<TorusContactCheck> tori;           ///< per torus of [[device.torus]]
   std::int64_t nonfinite_elements = 0;
   std::int64_t fastest_element = -1;  ///< element with the largest speed (or first non-finite)
   /// [volume] preserve only: volume enclosed by the surface (m³, world frame); else 0
@@ -44,7 +55,8 @@ std::size_t estimated_volume_device_bytes(std::size_t elements, std::size_t surf
 class Simulator {
  public:
   /// Uploads the model. Throws vb::Error for double precision on a device without fp64, a model
-  /// too large for the device's memory, or more than one indenter.
+  /// too large for the device's memory, or more indenters and tori than the check kernel's local
+  /// memory holds.
   Simulator(const Scene& scene, const Lattice& lattice, const ElementArrays& elements, const ClContext& cl);
 
   /// Enqueues `steps` time steps; returns without waiting for the device.
@@ -82,6 +94,9 @@ class Simulator {
   Precision precision() const { return precision_; }
   /// position of indenter i at simulated time t (m)
   Vec3 indenter_position(std::size_t i, double t_s) const;
+  /// [[device.torus]] only: each element's surface-area share (m², rest; 0 off the surface) that
+  /// contact pressures divide by
+  const std::vector<double>& contact_area_m2() const { return contact_area_host_; }
   const ClContext& context() const { return cl_; }
 
  private:
@@ -100,7 +115,12 @@ class Simulator {
   void adapt_relaxation_damping(StateCheck& c, const std::vector<double>& partial);
   void enqueue_stress(const cl::Buffer& u);
   void make_hyperelastic_buffers(const ElementArrays& el);
-  std::vector<double> indenter_table() const;
+  /// The rigid-obstacle table the kernels read (lattice frame): indenter rows (a placeholder row if
+  /// none), then torus rows and their inflation knots (kernels/device_contact.cl).
+  std::vector<double> obstacle_table() const;
+  /// torus rows start here in the table (reals)
+  std::size_t torus_table_base() const;
+  void make_contact_area_buffer();
   /// read-only buffer of reals in the run's precision
   cl::Buffer make_real_buffer(const std::vector<double>& values) const;
 
@@ -121,7 +141,9 @@ class Simulator {
   cl::Buffer u_, v_, u_tmp_, v_tmp_, E_, cell_, grid_, partial_, partial_arg_;
   bool hyper_ = false;
   cl::Buffer tissue_, materials_, Q_, F_;
-  cl::Buffer indenters_;  ///< indenter table (lattice frame)
+  cl::Buffer indenters_;  ///< rigid-obstacle table: indenters and tori (lattice frame)
+  cl::Buffer contact_area_;  ///< [[device.torus]]: per element surface-area share (m²)
+  std::vector<double> contact_area_host_;
   int check_slots_ = 0;  ///< hyperelastic: tissue ids, law table, Q and F rows
   cl::Kernel stress_;
   cl::Program program_;

@@ -69,6 +69,31 @@ then pass "NIfTI and DICOM inputs give the same result"
 else fail "NIfTI vs DICOM"; fi
 if dcmdump "$work/ct/warped_ct_dicom/CT00001.dcm" >/dev/null 2>&1; then pass "warped CT DICOM readable by dcmdump"; else fail "warped CT DICOM"; fi
 
+# --- the positioning sample: the phantom prone in a two-ring device (docs/POSITIONING.md)
+if "$bin" simulate "$root/data-samples/phantom/scene_device.toml" --out "$work/device" --quiet >"$work/device.txt" 2>&1 \
+   && grep -q "wrote .*metrics.csv" "$work/device.txt" && python3 - "$work/device" <<'PY'
+import csv, json, os, sys
+d = sys.argv[1]
+s = json.load(open(d + "/summary.json"))
+assert s["converged"], s["stop_reason"]
+tori = s["immobilisation_device"]["tori"]
+assert [t["name"] for t in tori] == ["base_ring", "front_ring"], tori
+for t in tori:
+    assert t["contact_elements"] > 10 and t["normal_force_sum_n"] > 0.1, t
+    assert t["max_penetration_during_run_m"] <= 1e-3 * 0.004, t  # the stated tolerance, 0.001·h
+p = s["positioning"]
+assert p["tumour"]["tissue"] == "tumour" and p["tumour"]["elements"] > 10, p["tumour"]
+assert p["tumour"]["displacement_m"][1] < 0, p["tumour"]  # prone: anteriorly
+assert p["tumour"]["final_target_distance_m"] is not None
+assert p["chest_wall"]["anchor"] == "chest" and p["chest_wall"]["tumour_distance_final_m"] > p["chest_wall"]["tumour_distance_rest_m"]
+rows = list(csv.DictReader(open(d + "/metrics.csv")))
+assert len(rows) == 1 and float(rows[0]["base_ring_normal_force_sum_n"]) > 0.1, rows
+for f in ("device_base_ring.vtp", "device_base_ring.stl", "device_front_ring.vtp", "surface.vtp"):
+    assert f in s["mesh_outputs"]["files"] and os.path.getsize(os.path.join(d, f)) > 1000, f
+PY
+then pass "positioning sample: converges, rings in contact within tolerance, metrics.csv and device meshes"
+else fail "positioning sample"; cat "$work/device.txt"; fi
+
 # --- bad input: each must fail with one 'voxbreast: error:' line naming the problem, and no result.h5
 scene() {  # base scene: a small block on a held base
   cat <<TOML
@@ -114,6 +139,7 @@ expect_error no_elements "no elements" "$(scene | sed 's/^max = \[0.01, 0.01, 0.
 expect_error unstable "unstable at step" "$(scene; printf '[solver]\nintegrator = "symplectic_euler"\ndt = 0.01\n')"
 expect_error unwritable_output "cannot write to output folder" "$(scene)" /proc/voxbreast-not-writable
 expect_error missing_material "soft" "$(scene | sed 's/^\[materials.soft\]/[materials.other]/')"
+expect_error torus_tube_too_big "toml:22 key 'device.torus\[0\].minor_radius'" "$(scene; printf '[[device.torus]]\ncenter = [0.005, 0.005, 0.0]\naxis = [0.0, 0.0, 1.0]\nmajor_radius = 0.01\nminor_radius = 0.01\n')"
 
 # A corrupt CT: the phantom scene with a truncated ct.nii.gz
 mkdir -p "$work/corrupt" && cp "$root/data-samples/phantom/labels.nii.gz" "$root/data-samples/phantom/scene.toml" "$work/corrupt/"

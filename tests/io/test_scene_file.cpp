@@ -433,8 +433,6 @@ std::vector<ErrorCase> error_cases() {
        {"duplicate track name 'apex'", "line 10"}},
       {"OutputDvfNeedsImage", kBase + "[output]\ndvf = true\n", "output.dvf", 11,
        {"needs a CT image model"}},
-      {"DeviceNotSupported", kBase + "[device]\nkind = \"torus\"\n", "device", 10,
-       {"not supported yet"}},
       {"VolumeUnknownKey", kBase + "[volume]\npreserve = true\nstiffness = 1.0\n", "volume.stiffness", 12,
        {"unknown key"}},
       {"VolumePreserveNotBool", kBase + "[volume]\npreserve = 1\n", "volume.preserve", 11,
