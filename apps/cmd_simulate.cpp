@@ -30,6 +30,7 @@ int run_simulate(const SimulateOptions& o) {
   scene.model.allow_gaps = scene.model.allow_gaps || o.allow_gaps;
   ensure_output_dir(o.out);  // fail before computing, not after
   const PreparedModel model = prepare_model(scene);
+  check_positioning(scene, model.lattice);  // a misnamed tumour tissue fails now, not after the run
   const ClContext cl(select_device(o.device));
   Simulator sim(scene, model.lattice, model.elements, cl);
   if (!o.quiet)
