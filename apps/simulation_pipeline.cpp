@@ -26,6 +26,7 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
   std::unique_lock io(file_io_mutex());
   const PreparedModel model = prepare_model(scene);
   io.unlock();
+  check_positioning(scene, model.lattice);  // a misnamed tumour tissue fails now, not after the run
   Simulator sim(scene, model.lattice, model.elements, cl);
   if (options.on_start) options.on_start(model, sim);
   const RunOutput result = run_simulation(scene, model.lattice, model.elements, sim, options.on_progress);
@@ -42,7 +43,8 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
     write_result_h5(out_dir + "/result.h5", model.lattice, scene, result.state, result.frames, result.summary);
     if (model.ct) {
       summary["image_outputs"] = write_image_outputs(out_dir, scene, model.lattice, *model.ct, result.state);
-      report.image_outputs = true;
+      const OutputSpec& out = scene.output;
+      report.image_outputs = out.dvf || out.warped_ct || out.warped_ct_dicom || out.fields;
     }
     if (scene.output.surfaces) {
       summary["mesh_outputs"] = write_mesh_outputs(out_dir, model.lattice, result.state, result.frames);

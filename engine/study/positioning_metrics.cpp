@@ -45,6 +45,8 @@ double quantile(std::vector<double> v, double q) {
 
 }  // namespace
 
+void check_positioning(const Scene& scene, const Lattice& lattice) { (void)tumour_tissue_index(scene, lattice); }
+
 double distance_from_anchor_m(const AnchorSpec& a, const Vec3& x) {
   switch (a.kind) {
     case AnchorSpec::Kind::Sphere:

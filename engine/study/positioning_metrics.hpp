@@ -51,6 +51,10 @@ struct PositioningMetrics {
 PositioningMetrics compute_positioning_metrics(const Scene& scene, const Lattice& lattice, const ElementArrays& elements,
                                                const RunSummary& summary, const FinalState& state);
 
+/// Throws the error compute_positioning_metrics would (a named tumour tissue the model lacks), so
+/// a run can fail before it starts rather than after.
+void check_positioning(const Scene& scene, const Lattice& lattice);
+
 /// Signed distance of x from the anchor's surface (m), positive outside the held region; sphere
 /// and halfspace anchors only.
 double distance_from_anchor_m(const AnchorSpec& anchor, const Vec3& x_m);
