@@ -169,8 +169,11 @@ TEST(BenchDesign, GridPlusOneFactorAtATimeEachCombinationOnce) {
   spec.dt_factors = {0.5, 1, 2};
   spec.tolerances = {1e-9};
   const auto cases = make_design("column", spec);
-  // grid 16; per base law: downsample 2, 4; dt 0.5, 2; volume; tolerance × 2 precisions
-  EXPECT_EQ(cases.size(), 16u + 2 * 7);
+  // grid: laws × integrators × 2 precisions; per base law: downsample 2, 4; dt 0.5, 2; volume;
+  // tolerance × 2 precisions
+  const std::size_t grid = law_names().size() * integrator_names().size() * 2;
+  EXPECT_EQ(law_names().size(), 4u);
+  EXPECT_EQ(cases.size(), grid + 2 * 7);
   std::set<std::string> knobs;
   for (const BenchCase& c : cases) EXPECT_TRUE(knobs.insert(c.knobs()).second) << "twice: " << c.knobs();
   EXPECT_EQ(cases.front().part, "base");
