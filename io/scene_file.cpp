@@ -1,4 +1,5 @@
 #include "io/scene_file.hpp"
+#include "io/toml_text.hpp"
 
 #include <toml++/toml.h>
 
@@ -872,17 +873,6 @@ void resolve_paths(ModelSpec& model, const std::string& scene_path) {
   }
 }
 
-toml::table parse_toml(const std::string& text, const std::string& source) {
-  try {
-    return toml::parse(std::string_view(text), std::string_view(source));
-  } catch (const toml::parse_error& e) {
-    const toml::source_position& at = e.source().begin;
-    throw Error("TOML syntax error: " + std::string(e.description()),
-                source + ":" + std::to_string(at.line) + ":" + std::to_string(at.column),
-                "fix the TOML syntax; see https://toml.io");
-  }
-}
-
 std::string read_text_file(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
@@ -898,7 +888,7 @@ std::string read_text_file(const std::string& path) {
 }  // namespace
 
 Scene parse_scene_text(const std::string& text, const std::string& source_name) {
-  const toml::table root = parse_toml(text, source_name);
+  const toml::table root = parse_toml_text(text, source_name);
   const Section top(root, "", source_name);
   top.check_keys(
       {"model", "materials", "solver", "gravity", "anchor", "indenter", "device", "positioning", "track", "stop",

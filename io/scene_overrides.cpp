@@ -1,4 +1,5 @@
 #include "io/scene_overrides.hpp"
+#include "io/toml_text.hpp"
 
 #include <toml++/toml.h>
 
@@ -14,17 +15,6 @@
 
 namespace vb {
 namespace {
-
-toml::table parse_toml_text(const std::string& text, const std::string& source) {
-  try {
-    return toml::parse(std::string_view(text), std::string_view(source));
-  } catch (const toml::parse_error& e) {
-    const toml::source_position& at = e.source().begin;
-    throw Error("TOML syntax error: " + std::string(e.description()),
-                source + ":" + std::to_string(at.line) + ":" + std::to_string(at.column),
-                "fix the TOML syntax; see https://toml.io");
-  }
-}
 
 bool is_bare_key(std::string_view part) {
   return !part.empty() && std::all_of(part.begin(), part.end(), [](unsigned char c) {

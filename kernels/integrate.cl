@@ -1,7 +1,7 @@
 // Time integrators. One work-item per element; held elements (u.w == 0) never move.
 // With VB_TORI the torus device (kernels/device_contact.cl) constrains each stage's acceleration
 // (a = f/m: removing its inward normal part removes the force's), applies friction to the new
-// velocity and projects the stage's end out of the tubes, after the indenters.
+// velocity and projects the stage's end out of the tubes, after the indenters (finish_stage).
 //   symplectic Euler (main paper eq. 11):  v' = v + dt·a(u, v);  u' = u + dt·v'
 //   Heun (improved Euler, trapezium rule): predictor ũ = u + dt·v, ṽ = v + dt·a(u, v);
 //     corrector u' = u + dt/2·(v + ṽ), v' = v + dt/2·(a(u, v) + a(ũ, ṽ)) = (v + ṽ)/2 + dt/2·a(ũ, ṽ)
@@ -19,10 +19,18 @@ inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, glo
   return f * ui.w;
 }
 
+// Ends a stage: moves an element that ended inside an indenter or a torus tube back onto its
+// surface (indenters first; the obstacle table holds both).
 inline void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_of, int sy, int sz,
                          real4 origin, real h, global const real* indenters, real t) {
+#if VB_INDENTERS || VB_TORI
+  const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
+#endif
 #if VB_INDENTERS
-  contact_project_all(un, vn, rest_position(cell_of[e], sy, sz, origin, h), indenters, t, h);
+  contact_project_all(un, vn, X, indenters, t, h);
+#endif
+#if VB_TORI
+  torus_project_all(un, vn, X, indenters, t, h);
 #endif
 }
 
@@ -51,9 +59,6 @@ inline void explicit_stage(global const real4* u, global const real4* v, global 
     if (!symplectic) torus_apply_grip(&vi, grip, dt);
 #endif
     finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, indenters, t_project);
-#if VB_TORI
-    torus_project_all(&ui, &vi, X, indenters, t_project, h);
-#endif
   }
   u_out[e] = ui;
   v_out[e] = vi;
@@ -91,9 +96,6 @@ kernel void heun_correct(global real4* u, global real4* v, global const real4* u
 #endif
   ui += (real)0.5 * dt * xyz0(vi + vp);
   finish_stage(e, &ui, &vn, cell_of, sy, sz, origin, h, indenters, t_project);
-#if VB_TORI
-  torus_project_all(&ui, &vn, X, indenters, t_project, h);
-#endif
   u[e] = ui;
   v[e] = vn;
 }

@@ -13,18 +13,12 @@ kernel void relax_step(global const real4* u, global const real4* v, global real
   if (e >= n) return;
   real4 ui = u[e], vi = v[e];
   if (ui.w != 0) {
-    const real inverse_mass = ui.w * relax_scale[e];  // 1/m̃
-    real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS) - c * xyz0(vi) / inverse_mass;
-#if VB_INDENTERS || VB_TORI
-    const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
-#endif
-#if VB_INDENTERS
-    contact_constrain_all(&f, X + xyz0(ui), indenters, t_force, h);
-#endif
-    real4 a = inverse_mass * f;
+    // acceleration() is f/m with the indenters' constraint (no global damping is compiled in);
+    // m/m̃ turns it into f/m̃, then the fictitious damping.
+    real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force) * relax_scale[e] - c * xyz0(vi);
 #if VB_TORI
     torus_grip grip = {0};  // on the acceleration, as in integrate.cl
-    torus_constrain_all(&a, X + xyz0(ui), indenters, t_force, h, &grip);
+    torus_constrain_all(&a, rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui), indenters, t_force, h, &grip);
 #endif
     vi = xyz0(vi + dt * a);
 #if VB_TORI
@@ -32,9 +26,6 @@ kernel void relax_step(global const real4* u, global const real4* v, global real
 #endif
     ui += dt * vi;
     finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, indenters, t_project);
-#if VB_TORI
-    torus_project_all(&ui, &vi, X, indenters, t_project, h);
-#endif
   }
   u_out[e] = ui;
   v_out[e] = vi;

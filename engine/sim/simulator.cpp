@@ -587,11 +587,11 @@ StateCheck Simulator::check() {
     }
   }
   if (volume_) c.enclosed_volume_m3 = read_enclosed_volume_m3();
-  if (relax_) adapt_relaxation_damping(c, p);
+  if (relax_) adapt_relaxation_damping(p);
   return c;
 }
 
-void Simulator::adapt_relaxation_damping(StateCheck& c, const std::vector<double>& partial) {
+void Simulator::adapt_relaxation_damping(const std::vector<double>& partial) {
   // Underwood's adaptive dynamic relaxation: c = 2·ω_min damps the slowest mode critically. Every
   // Rayleigh quotient is ≥ ω_min², so the smallest one seen (of u, of the change since the last
   // check, and the previous estimate) is the best; it only moves down, towards ω_min². Capped
@@ -604,7 +604,7 @@ void Simulator::adapt_relaxation_damping(StateCheck& c, const std::vector<double
   for (int k : {0, 2})
     if (sum[k] > 0 && sum[k + 1] > 0) omega_sq = std::min(omega_sq, sum[k] / sum[k + 1]);
   if (!std::isfinite(omega_sq)) return;  // no displacement yet: keep c
-  relax_omega_sq_ = c.rayleigh_omega_sq = omega_sq;
+  relax_omega_sq_ = omega_sq;
   damping_ = std::min(2 * std::sqrt(omega_sq), 0.5 / dt_.dt_s);
   set_real(relax_kernel_, kStepIndenter + kIndenterArgs + 3, damping_);
 }

@@ -38,9 +38,6 @@ struct StateCheck {
   std::int64_t fastest_element = -1;  ///< element with the largest speed (or first non-finite)
   /// [volume] preserve only: volume enclosed by the surface (m³, world frame); else 0
   double enclosed_volume_m3 = 0;
-  /// relaxation only: Rayleigh quotient uᵀKu / uᵀM̃u of the displacement (1/s²), the estimate of
-  /// the lowest mode's ω² that sets the damping (kernels/checks.cl); else 0
-  double rayleigh_omega_sq = 0;
 };
 
 /// Device bytes a model of `elements` elements in a padded grid of `cells` voxels needs
@@ -69,8 +66,6 @@ class Simulator {
   void set_gravity(const Vec3& acceleration_m_s2);
   /// Counts time from zero again (the next run starts at t = 0, indenters at their start).
   void restart_clock() { steps_ = 0; }
-  /// relaxation: the damping rate the steps use now (1/s); else the scene's global damping
-  double damping_per_s() const { return damping_; }
 
   /// Current state as n×3 doubles in the world frame.
   void download(std::vector<double>& u_m, std::vector<double>& v_m_s) const;
@@ -112,7 +107,7 @@ class Simulator {
   std::vector<double> to_lattice_frame(const std::vector<double>& world) const;
   void enqueue(cl::Kernel& k) const;
   void enqueue_check() const;
-  void adapt_relaxation_damping(StateCheck& c, const std::vector<double>& partial);
+  void adapt_relaxation_damping(const std::vector<double>& partial);
   void enqueue_stress(const cl::Buffer& u);
   void make_hyperelastic_buffers(const ElementArrays& el);
   /// The rigid-obstacle table the kernels read (lattice frame): indenter rows (a placeholder row if
