@@ -40,8 +40,8 @@ int run_simulate(const SimulateOptions& o) {
   options.on_reference_iteration = [&](const ReferenceIteration& r) {
     if (o.quiet) return;
     bar.finish();
-    std::fprintf(stderr, "voxbreast: unloaded state, iteration %d: lands %.4f mm from the CT (rms %.4f mm, %lld steps)\n",
-                 r.iteration, 1e3 * r.residual_max_m, 1e3 * r.residual_rms_m, (long long)r.steps);
+    std::fprintf(stderr, "voxbreast: unloaded state, iteration %d (step %.3g): lands %.4f mm from the CT (rms %.4f mm, %lld steps)\n",
+                 r.iteration, r.step, 1e3 * r.residual_max_m, 1e3 * r.residual_rms_m, (long long)r.steps);
   };
   options.on_perturbed_run = [&](const PerturbedRun& r) {
     if (o.quiet) return;

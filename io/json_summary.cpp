@@ -124,6 +124,7 @@ json reference_state_to_json(const ReferenceState& r, const ReferenceStateSpec& 
     history.push_back({{"iteration", it.iteration},
                        {"residual_max_m", number(it.residual_max_m)},
                        {"residual_rms_m", number(it.residual_rms_m)},
+                       {"step", number(it.step)},
                        {"steps", it.steps}});
   return {{"ct_posture", spec.ct_posture.empty() ? json(nullptr) : json(spec.ct_posture)},
           {"ct_gravity_m_s2", vec3(spec.ct_gravity_m_s2)},
@@ -133,6 +134,7 @@ json reference_state_to_json(const ReferenceState& r, const ReferenceStateSpec& 
           {"residual_max_m", number(r.residual_max_m)},
           {"residual_rms_m", number(r.residual_rms_m)},
           {"max_rest_offset_m", number(r.max_rest_offset_m)},
+          {"unsupported_elements", r.unsupported_elements},
           {"steps", r.steps},
           {"wall_time_s", number(r.wall_time_s)},
           {"history", history}};

@@ -1,5 +1,6 @@
 #include "engine/loads/anchors.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -46,6 +47,18 @@ AnchorPlacement place_anchors(const Lattice& lattice, const std::vector<AnchorSp
             "anchor." + a.name + (a.line ? " (line " + std::to_string(a.line) + ")" : ""),
             "move or enlarge it so it overlaps the model");
     out.held_per_anchor.push_back(count);
+  }
+  // A posed sphere turns the patient as a whole: free elements start turned with the last one, so
+  // a posture change does not begin with the chest wall torn from the tissue in front of it.
+  const auto posed_sphere = [](const AnchorSpec& a) { return a.kind == AnchorSpec::Kind::Sphere && a.rpy_deg.squaredNorm() > 0; };
+  const auto last = std::find_if(anchors.rbegin(), anchors.rend(), posed_sphere);
+  if (last != anchors.rend()) {
+    const Eigen::Matrix3d R = rotation_from_rpy_deg(last->rpy_deg);
+    for (std::size_t e = 0; e < n; ++e) {
+      if (out.held[e]) continue;
+      const Vec3 X = lattice.rest_position(e);
+      out.displacement_m[e] = R * (X - last->center_m) + last->center_m - X;
+    }
   }
   return out;
 }

@@ -18,7 +18,9 @@ bool anchor_contains(const AnchorSpec& anchor, const Vec3& p);
 
 struct AnchorPlacement {
   std::vector<std::uint8_t> held;  ///< n_elements, 1 = held by some anchor
-  std::vector<Vec3> displacement_m;  ///< n_elements, prescribed displacement of held elements (m)
+  /// n_elements (m): the prescribed displacement of held elements; free elements start turned
+  /// rigidly with the last posed sphere anchor (zero when none is posed)
+  std::vector<Vec3> displacement_m;
   std::vector<std::size_t> held_per_anchor;  ///< count per anchor, in scene order
 };
 

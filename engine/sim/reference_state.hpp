@@ -14,18 +14,23 @@ namespace vb {
 
 struct ReferenceIteration {
   int iteration = 0;          ///< 1-based
-  double residual_max_m = 0;  ///< largest |u*| over free elements: how far the model lands from the CT
-  double residual_rms_m = 0;  ///< RMS |u*| over free elements
+  double residual_max_m = 0;  ///< largest |u*| over free elements (but unsupported ones, below):
+                              ///< how far the model lands from the CT
+  double residual_rms_m = 0;  ///< RMS |u*| over them (both +inf for an unstable solve)
   std::int64_t steps = 0;     ///< relaxation steps of this forward solve
+  double step = 1;            ///< β of the update u0 − β·u* tried (1 for the first solve)
 };
 
 struct ReferenceState {
   std::vector<double> rest_offset_m;  ///< n×3, world frame (m); zero for held elements
-  std::vector<ReferenceIteration> history;
+  std::vector<ReferenceIteration> history;  ///< every forward solve, rejected steps included
   bool converged = false;      ///< the last residual is within [reference_state] tolerance
   double residual_max_m = 0;   ///< of the returned rest offsets (the last iteration's)
   double residual_rms_m = 0;
   double max_rest_offset_m = 0;  ///< largest |u0|: how far the unloaded shape is from the CT
+  /// free elements left out of the residual: their neighbours lie in a plane or a line (one-voxel
+  /// sheets and strands), so nothing holds them at their CT position against gravity across it
+  std::size_t unsupported_elements = 0;
   std::int64_t steps = 0;        ///< all forward solves together
   double wall_time_s = 0;
 };
@@ -36,7 +41,9 @@ struct ReferenceState {
 Scene reference_state_scene(const Scene& scene);
 
 /// Runs the iteration on `cl` (its own simulator) until the residual is within tolerance or
-/// [reference_state] max_iterations is reached (then `converged` is false). `on_iteration` is
+/// [reference_state] max_iterations forward solves are done (then `converged` is false). A step
+/// that lands farther from the CT (or goes unstable) is retried shorter: history lists every
+/// solve, and the result keeps the best rest offsets. `on_iteration` is
 /// called after each forward solve. Throws vb::Error when a forward solve does not reach
 /// equilibrium or goes unstable.
 ReferenceState estimate_reference_state(const Scene& scene, const Lattice& lattice, const ClContext& cl,

@@ -3,29 +3,10 @@
 #include <random>
 
 #include "engine/error.hpp"
-#include "engine/loads/anchors.hpp"
 #include "engine/sim/run.hpp"
 #include "engine/study/positioning_metrics.hpp"
 
 namespace vb {
-namespace {
-
-/// The start of a perturbed run: the whole patient turned rigidly with the chest wall (a posture
-/// change turns the body, not just the ribs), held elements at their prescribed pose.
-std::vector<double> turned_with_chest_wall(const Lattice& lattice, const ElementArrays& el, const AnchorSpec& wall) {
-  const Eigen::Matrix3d R = rotation_from_rpy_deg(wall.rpy_deg);
-  std::vector<double> u = el.displacement_m;
-  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
-    if (el.inverse_mass[e] == 0) continue;
-    const Vec3 X = lattice.rest_position(e);
-    const Vec3 d = R * (X - wall.center_m) + wall.center_m - X;
-    for (int c = 0; c < 3; ++c) u[3 * e + c] = d[c];
-  }
-  return u;
-}
-
-}  // namespace
-
 std::vector<Vec3> perturbation_angles_deg(const ReproducibilitySpec& spec) {
   std::mt19937_64 bits(spec.seed);
   // [0, 1) from the top 53 bits: distributions are implementation-defined, the engine is not.
@@ -80,7 +61,7 @@ ReproducibilityResult run_reproducibility(const Scene& scene, const Lattice& lat
       Scene posed = config;
       posed.anchors[wall_index].rpy_deg += angles[k];
       const ElementArrays el = make_element_arrays(posed, lattice);  // the held elements' new pose
-      sim.upload(turned_with_chest_wall(lattice, el, posed.anchors[wall_index]), at_rest);
+      sim.upload(el.displacement_m, at_rest);  // the patient turned with the chest wall
       sim.restart_clock();
       const RunOutput run = run_simulation(posed, lattice, el, sim);
       const PositioningMetrics m = compute_positioning_metrics(posed, lattice, el, run.summary, run.state);

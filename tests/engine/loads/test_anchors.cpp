@@ -47,6 +47,14 @@ TEST_P(SphereAnchorPose, MovesAnchoredElementsByExactlyThatRotation) {
   }
   EXPECT_EQ(held, m.elements.held_count);
   EXPECT_GT(held, 0u);
+  // the free elements start turned with it (the patient turns as a whole)
+  for (std::size_t e = 0; e < m.lattice.element_count(); ++e) {
+    const Vec3 X = m.lattice.rest_position(e);
+    if (anchor_contains(s.anchors[0], X)) continue;
+    const Vec3 expected = R * (X - s.anchors[0].center_m) + s.anchors[0].center_m - X;
+    EXPECT_LT((expected - Vec3(m.elements.displacement_m[3 * e], m.elements.displacement_m[3 * e + 1],
+                               m.elements.displacement_m[3 * e + 2])).norm(), 1e-15) << "element " << e;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Poses, SphereAnchorPose,
