@@ -88,10 +88,20 @@ assert p["tumour"]["final_target_distance_m"] is not None
 assert p["chest_wall"]["anchor"] == "chest" and p["chest_wall"]["tumour_distance_final_m"] > p["chest_wall"]["tumour_distance_rest_m"]
 rows = list(csv.DictReader(open(d + "/metrics.csv")))
 assert len(rows) == 1 and float(rows[0]["base_ring_normal_force_sum_n"]) > 0.1, rows
-for f in ("device_base_ring.vtp", "device_base_ring.stl", "device_front_ring.vtp", "surface.vtp"):
+for f in ("device_base_ring.vtp", "device_base_ring.stl", "device_front_ring.vtp", "surface.vtp", "surface_unloaded.vtp"):
     assert f in s["mesh_outputs"]["files"] and os.path.getsize(os.path.join(d, f)) > 1000, f
+# the unloaded reference state (CT supine): within its tolerance, and supine gravity undone
+r = s["reference_state"]
+assert r["converged"] and r["residual_max_m"] <= 1e-5 and r["max_rest_offset_m"] > 5e-4, r
+# reproducibility: the same angles with and without the device; the device holds the tumour better
+q = p["reproducibility"]
+assert len(q["runs"]) == 2 * q["perturbations"] and all(run["converged"] for run in q["runs"]), q["runs"]
+assert q["with_device"]["std_m"] < q["without_device"]["std_m"], (q["with_device"], q["without_device"])
+assert q["without_device"]["std_m"] > 1e-3, q["without_device"]  # ±1° turns move the tumour by mm
+assert abs(float(rows[0]["tumour_spread_std_device_mm"]) - 1e3 * q["with_device"]["std_m"]) < 1e-6, rows[0]
+assert len(list(csv.DictReader(open(d + "/reproducibility.csv")))) == 2 * q["perturbations"]
 PY
-then pass "positioning sample: converges, rings in contact within tolerance, metrics.csv and device meshes"
+then pass "positioning sample: converges, rings in contact within tolerance, reference state, device reduces the tumour spread, metrics.csv and device meshes"
 else fail "positioning sample"; cat "$work/device.txt"; fi
 
 # --- bad input: each must fail with one 'voxbreast: error:' line naming the problem, and no result.h5

@@ -265,6 +265,27 @@ TEST(SceneFile, VolumeSectionParses) {
   EXPECT_FALSE(parse_scene_text(kBase + "[volume]\npreserve = false\n", "scene.toml").volume.preserve);
 }
 
+TEST(SceneFile, ReferenceStateAndReproducibilitySectionsParse) {
+  const Scene s = parse_scene_text(kBase +
+                                       "[gravity]\nposture = \"prone\"\n"
+                                       "[anchor.chest]\nkind = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0.01\n"
+                                       "[reference_state]\nct_posture = \"supine\"\ntolerance_mm = 0.02\n"
+                                       "[reproducibility]\nperturbations = 5\nmax_angle_deg = 2\nseed = 7\n",
+                                   "scene.toml");
+  EXPECT_TRUE(s.reference_state.active);
+  EXPECT_EQ(s.reference_state.ct_posture, "supine");
+  EXPECT_NEAR(s.reference_state.ct_gravity_m_s2.y(), 9.80665, 1e-12);
+  EXPECT_DOUBLE_EQ(s.reference_state.tolerance_m, 2e-5);
+  EXPECT_EQ(s.reference_state.max_iterations, 20);
+  EXPECT_TRUE(s.reproducibility.active);
+  EXPECT_EQ(s.reproducibility.perturbations, 5);
+  EXPECT_DOUBLE_EQ(s.reproducibility.max_angle_deg, 2.0);
+  EXPECT_EQ(s.reproducibility.seed, 7u);
+  const Scene plain = parse_scene_text(kBase, "scene.toml");
+  EXPECT_FALSE(plain.reference_state.active);
+  EXPECT_FALSE(plain.reproducibility.active);
+}
+
 TEST(SceneFile, DtAutoAndGravityVector) {
   const Scene s = parse_scene_text(
       kBase + "[solver]\ndt = \"auto\"\n[gravity]\nvector = [0, 0, -9.81]\n", "scene.toml");
@@ -442,6 +463,22 @@ std::vector<ErrorCase> error_cases() {
       {"VolumeEveryFloat", kBase + "[volume]\nevery = 2.0\n", "volume.every", 11,
        {"expected an integer"}},
       {"TomlSyntaxError", kBase + "[solver\n", "", 10, {"TOML syntax error", "scene.toml:10:"}},
+      {"ReferenceStateNeedsPosture", kBase + "[gravity]\nposture = \"prone\"\n[reference_state]\ntolerance_mm = 0.01\n",
+       "reference_state.ct_posture", 12, {"needs the CT's posture"}},
+      {"ReferenceStatePostureAndVector", kBase + "[gravity]\nposture = \"prone\"\n[reference_state]\nct_posture = \"supine\"\nct_gravity = [0, 9.81, 0]\n",
+       "reference_state.ct_gravity", 14, {"not both"}},
+      {"ReferenceStateUnknownPosture", kBase + "[gravity]\nposture = \"prone\"\n[reference_state]\nct_posture = \"supin\"\n",
+       "reference_state.ct_posture", 13, {"supine"}},
+      {"ReferenceStateNegativeTolerance", kBase + "[gravity]\nposture = \"prone\"\n[reference_state]\nct_posture = \"supine\"\ntolerance_mm = -1\n",
+       "reference_state.tolerance_mm", 14, {}},
+      {"ReferenceStateNeedsGravity", kBase + "[reference_state]\nct_posture = \"supine\"\n",
+       "reference_state", 10, {"needs a [gravity] section"}},
+      {"ReproducibilityNeedsSphere", kBase + "[reproducibility]\nperturbations = 4\n",
+       "reproducibility.perturbations", 11, {"sphere anchor"}},
+      {"ReproducibilityOnePerturbation", kBase + "[reproducibility]\nperturbations = 1\n",
+       "reproducibility.perturbations", 11, {"integer ≥ 2"}},
+      {"ReproducibilityAngleTooLarge", kBase + "[anchor.chest]\nkind = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0.01\n[reproducibility]\nmax_angle_deg = 60\n",
+       "reproducibility.max_angle_deg", 15, {"at most 45"}},
   };
 }
 // clang-format on

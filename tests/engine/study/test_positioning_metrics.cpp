@@ -112,3 +112,44 @@ TEST(PositioningMetrics, MissingTumourTissueIsAnErrorOnlyWhenNamed) {
 
 }  // namespace
 }  // namespace vb
+
+// ---- reproducibility (engine/study/reproducibility.cpp) ---------------------------------------
+
+namespace vb {
+namespace {
+
+TEST(Reproducibility, AnglesAreSeededUniformWithinTheBound) {
+  ReproducibilitySpec spec;
+  spec.perturbations = 400;
+  spec.max_angle_deg = 1.5;
+  spec.seed = 3;
+  const std::vector<Vec3> a = perturbation_angles_deg(spec), again = perturbation_angles_deg(spec);
+  ASSERT_EQ(a.size(), 400u);
+  EXPECT_EQ(a, again);  // the same seed, the same study
+  spec.seed = 4;
+  EXPECT_NE(a, perturbation_angles_deg(spec));
+  Vec3 mean = Vec3::Zero(), mean_sq = Vec3::Zero();
+  for (const Vec3& x : a) {
+    EXPECT_LE(x.cwiseAbs().maxCoeff(), 1.5);
+    mean += x / 400.0;
+    mean_sq += x.cwiseProduct(x) / 400.0;
+  }
+  // uniform on [−θ, θ]: mean 0, variance θ²/3 = 0.75 (sampling error ~0.04 and ~0.04 here)
+  EXPECT_LT(mean.cwiseAbs().maxCoeff(), 0.2);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean_sq[c], 0.75, 0.15);
+}
+
+TEST(Reproducibility, SpreadIsTheRmsAndLargestDistanceFromTheMean) {
+  const std::vector<Vec3> p = {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 2, 0), Vec3(0, -2, 0)};
+  const TumourSpread s = tumour_spread(p);
+  EXPECT_EQ(s.runs, 4);
+  EXPECT_LT(s.mean_m.norm(), 1e-15);
+  EXPECT_NEAR(s.std_axis_m.x(), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(s.std_axis_m.y(), std::sqrt(2.0), 1e-15);
+  EXPECT_NEAR(s.std_m, std::sqrt(2.5), 1e-15);  // mean of 1, 1, 4, 4
+  EXPECT_DOUBLE_EQ(s.max_m, 2.0);
+  EXPECT_EQ(tumour_spread({}).runs, 0);
+}
+
+}  // namespace
+}  // namespace vb
