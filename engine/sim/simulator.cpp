@@ -206,13 +206,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   program_ = build_program(cl, sources, lattice_tables_source(), options);
   if (hyper_) {
     stress_ = cl::Kernel(program_, "element_stress");
-    stress_.setArg(1, tissue_);
-    stress_.setArg(2, materials_);
-    stress_.setArg(3, cell_);
-    stress_.setArg(4, grid_);
-    stress_.setArg(5, cl_int(stride_y_));
-    stress_.setArg(6, cl_int(stride_z_));
-    set_real(stress_, 7, lattice_.spacing_m);
+    set_element_fit_args(stress_);
     stress_.setArg(8, Q_);
     stress_.setArg(9, F_);
     stress_.setArg(10, cl_uint(n_));
@@ -269,13 +263,7 @@ void Simulator::set_rest_offsets(const std::vector<double>& u0) {
   if (hyper_) {
     cl::Kernel k(program_, "rest_frame");
     k.setArg(0, rest_offset_);
-    k.setArg(1, tissue_);
-    k.setArg(2, materials_);
-    k.setArg(3, cell_);
-    k.setArg(4, grid_);
-    k.setArg(5, cl_int(stride_y_));
-    k.setArg(6, cl_int(stride_z_));
-    set_real(k, 7, lattice_.spacing_m);
+    set_element_fit_args(k);
     k.setArg(8, rest_frame_);
     k.setArg(9, cl_uint(n_));
     enqueue(k);
@@ -471,6 +459,17 @@ void Simulator::set_world_vector(cl::Kernel& k, int index, const Vec3& world) co
   const Vec3 x = lattice_.rotation.transpose() * world;  // kernels work in the lattice frame
   if (precision_ == Precision::Double) set_vec<double, cl_double4>(k, index, x);
   else set_vec<float, cl_float4>(k, index, x);
+}
+
+void Simulator::set_element_fit_args(cl::Kernel& k) {
+  // kernels/hyperelastic.cl: element_stress and rest_frame take these after the displacements
+  k.setArg(1, tissue_);
+  k.setArg(2, materials_);
+  k.setArg(3, cell_);
+  k.setArg(4, grid_);
+  k.setArg(5, cl_int(stride_y_));
+  k.setArg(6, cl_int(stride_z_));
+  set_real(k, 7, lattice_.spacing_m);
 }
 
 void Simulator::set_lattice_args(cl::Kernel& k, int a) {

@@ -102,6 +102,8 @@ class Simulator {
  private:
   void set_indenter_args(cl::Kernel& k, int first_arg, double t_force, double t_project);
   void set_lattice_args(cl::Kernel& k, int first_arg);
+  /// arguments 1–7 of the per-element gradient fits (tissue ids, materials, grid, spacing)
+  void set_element_fit_args(cl::Kernel& k);
   void set_real(cl::Kernel& k, int index, double x) const;
   /// sets a world vector, rotated into the lattice frame the kernels work in
   void set_world_vector(cl::Kernel& k, int index, const Vec3& world) const;

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Sample device-design sweep (docs/POSITIONING.md, "Comparing designs"): the positioning sample
+# (phantom CT supine → prone, unloaded reference state, two inflating rings) with the front ring
+# at three major radii — the tighter the ring, the deeper it grips — each with its reproducibility
+# study cut to 2 postures, so the tumour's spread with and without the device is a column of
+# metrics.csv next to the ring forces and pressures. 3 cases, a few minutes on a 2-core CPU.
+#   bash data-samples/phantom/sweep_device.sh [OUT_DIR] [more voxbreast sweep options, e.g. --devices all]
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+bin=${VOXBREAST_BIN:-$here/../../build/apps/voxbreast}
+out=${1:-out/device_sweep}
+shift || true
+exec "$bin" sweep "$here/scene_device.toml" \
+  --vary device.torus.2.major_radius=0.050:0.056:3 \
+  --vary reproducibility.perturbations=2 \
+  --out "$out" "$@"
