@@ -29,3 +29,5 @@ bash scripts/gpu_run.sh run voxbreast info >"$out/device.txt" 2>&1 || true
 bash scripts/gpu_run.sh run voxbreast bench --device gpu --out "$out" --phantom data-samples/phantom/scene.toml \
   --sizes 22 33 50 80 115 160 ${BENCH_ARGS:-} 2>&1 | tee "$out/bench.log"
 if command -v python3 >/dev/null; then python3 tests/apps/check_bench.py "$out" | tail -20; fi
+# Few files come back from the device: one archive as well (unpack with tar -xzf bench.tar.gz).
+tar -C "$out/.." -czf "$out/../bench.tar.gz" bench

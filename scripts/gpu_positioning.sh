@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The positioning samples on a GPU, in one device call (docs/POSITIONING.md, docs/SWEEP.md): the
 # two-ring device sample (unloaded state + reproducibility), the device-design sweep and the
-# phantom sweep. Results come back under $OUT/positioning.
+# phantom sweep. Results come back as $OUT/positioning.tar.gz.
 #   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
 #   device: bash scripts/gpu_positioning.sh        (run tool, carry [".device-pkgs"])
 set -euo pipefail
@@ -19,4 +19,6 @@ rm -f "$out/device/result.h5"  # large; summary.json, metrics.csv and reproducib
 { time VOXBREAST_BIN=voxbreast run bash data-samples/phantom/sweep.sh "$out/phantom_sweep" --devices gpu; } \
   >"$out/phantom_sweep.log" 2>&1 || echo "phantom sweep failed (see phantom_sweep.log)"
 find "$out" -name '*.h5' -delete
-tail -3 "$out"/*.log
+for log in "$out"/*.log; do tail -n 3 "$log"; done
+# Few files come back from the device: one archive (unpack with tar -xzf positioning.tar.gz).
+tar -C "$out/.." -czf "$out/../positioning.tar.gz" positioning && rm -rf "$out"
