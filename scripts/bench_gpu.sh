@@ -4,6 +4,7 @@
 #   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
 #   device: bash scripts/bench_gpu.sh            (run tool, carry [".device-pkgs"]; writes $OUT/bench)
 #   here:   bash scripts/bench_gpu.sh plot FETCHED/bench h200   # docs/results/ and docs/img/ files
+# $BENCH_TIMEOUT (s) stops the study early but still packs what it wrote.
 # Extra bench options go in $BENCH_ARGS, e.g. BENCH_ARGS="--scenes phantom_large --laws neo-hookean".
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -26,8 +27,8 @@ mkdir -p "$out"
 bash scripts/gpu_run.sh run voxbreast info >"$out/device.txt" 2>&1 || true
 # Full study (column, phantom, ~1.5M-element phantom) and the cube throughput series.
 # shellcheck disable=SC2086
-bash scripts/gpu_run.sh run voxbreast bench --device gpu --out "$out" --phantom data-samples/phantom/scene.toml \
-  --sizes 22 33 50 80 115 160 ${BENCH_ARGS:-} 2>&1 | tee "$out/bench.log"
+${BENCH_TIMEOUT:+timeout $BENCH_TIMEOUT} bash scripts/gpu_run.sh run voxbreast bench --device gpu --out "$out" --phantom data-samples/phantom/scene.toml \
+  --sizes 22 33 50 80 115 160 ${BENCH_ARGS:-} 2>&1 | tee "$out/bench.log" || echo "bench stopped early (see bench.log)"
 if command -v python3 >/dev/null; then python3 tests/apps/check_bench.py "$out" | tail -20; fi
 # Few files come back from the device: one archive as well (unpack with tar -xzf bench.tar.gz).
 tar -C "$out/.." -czf "$out/../bench.tar.gz" bench
