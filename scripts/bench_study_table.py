@@ -23,7 +23,7 @@ def g(x, digits=3):
 
 
 def knobs(r):
-    integ = "Euler" if r["integrator"] == "symplectic_euler" else "Heun"
+    integ = {"symplectic_euler": "Euler", "heun": "Heun", "relaxation": "relaxation"}.get(r["integrator"], r["integrator"])
     out = f'{r["law"]}, {integ}, {r["precision"]}'
     if r["downsample"] != "1":
         out += f', downsample {r["downsample"]}'
