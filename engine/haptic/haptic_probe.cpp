@@ -15,8 +15,8 @@ HapticProbe::HapticProbe(const Scene& scene, const Lattice& lattice, const Eleme
                          const ClContext& cl, HapticOptions options)
     : options_(options), sim_(scene, lattice, elements, cl) {
   require(options.probe < scene.indenters.size(),
-          "the haptic probe is indenter " + std::to_string(options.probe + 1) + " but the scene has " +
-              std::to_string(scene.indenters.size()),
+          "the haptic probe is indenter " + std::to_string(options.probe + 1) + ", but the scene has " +
+              std::to_string(scene.indenters.size()) + " indenters",
           "indenter", "add a [[indenter]] with kind = \"sphere\" (its start is where the probe begins)");
   const IndenterSpec& probe = scene.indenters[options.probe];
   require(probe.kind == IndenterSpec::Kind::Sphere, "the haptic probe must be a sphere indenter",
