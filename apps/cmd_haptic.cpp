@@ -18,7 +18,7 @@ struct HapticCliOptions {
   std::string scene, trajectory, out, device, precision;
   double rate_hz = 1000, seconds = 0;
   int probe = 1, steps_per_update = 0;
-  bool quiet = false;
+  bool quiet = false, no_realtime = false;
 };
 
 int run_haptic(const HapticCliOptions& o) {
@@ -35,6 +35,7 @@ int run_haptic(const HapticCliOptions& o) {
   HapticLoopOptions loop;
   loop.rate_hz = o.rate_hz;
   loop.seconds = o.seconds;
+  loop.realtime = !o.no_realtime;
   if (!o.quiet)
     std::fprintf(stderr, "voxbreast: %zu elements, dt = %.3g s, device %s; force output at %g Hz for %g s\n",
                  model.lattice.element_count(), probe.simulator().dt_s(), cl.info.name.c_str(), o.rate_hz,
@@ -75,6 +76,7 @@ Command add_haptic(CLI::App& app) {
                   "time steps per deformation update (default solver.check_every)")->check(CLI::PositiveNumber);
   sub->add_option("--device,-d", o->device, "OpenCL device: gpu, cpu, an index or a name");
   sub->add_option("--precision", o->precision, "override solver.precision")->check(CLI::IsMember({"float", "double"}));
+  sub->add_flag("--no-realtime", o->no_realtime, "keep the output loop at normal priority (default: SCHED_FIFO where allowed)");
   sub->add_flag("--quiet,-q", o->quiet, "no start-up line");
   return {sub, [o] { return run_haptic(*o); }};
 }
