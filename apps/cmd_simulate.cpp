@@ -37,6 +37,20 @@ int run_simulate(const SimulateOptions& o) {
                   p.residual, p.speed_ratio);
     bar.update(double(p.step) / double(p.max_steps), text);
   };
+  options.on_reference_iteration = [&](const ReferenceIteration& r) {
+    if (o.quiet) return;
+    bar.finish();
+    std::fprintf(stderr, "voxbreast: unloaded state, iteration %d: lands %.4f mm from the CT (rms %.4f mm, %lld steps)\n",
+                 r.iteration, 1e3 * r.residual_max_m, 1e3 * r.residual_rms_m, (long long)r.steps);
+  };
+  options.on_perturbed_run = [&](const PerturbedRun& r) {
+    if (o.quiet) return;
+    bar.finish();
+    std::fprintf(stderr, "voxbreast: posture %d/%d %s device (roll %.2f, pitch %.2f, yaw %.2f deg): tumour at (%.2f, %.2f, %.2f) mm\n",
+                 r.index, scene.reproducibility.perturbations, r.device ? "with" : "without", r.rpy_deg.x(),
+                 r.rpy_deg.y(), r.rpy_deg.z(), 1e3 * r.tumour_centroid_m.x(), 1e3 * r.tumour_centroid_m.y(),
+                 1e3 * r.tumour_centroid_m.z());
+  };
   const SimulationReport report = simulate_scene(scene, cl, o.out, options);
   bar.finish();
 
@@ -51,6 +65,16 @@ int run_simulate(const SimulateOptions& o) {
   if (report.positioning.tumour)
     std::printf("tumour '%s' centroid moved %.3f mm\n", report.positioning.tumour->tissue.c_str(),
                 1e3 * report.positioning.tumour->displacement_m().norm());
+  if (const auto& r = report.positioning.reference_state)
+    std::printf("unloaded reference state: %d iterations, lands %.4f mm from the CT; it lies up to %.3f mm from the CT\n",
+                r->iterations, 1e3 * r->residual_max_m, 1e3 * r->max_rest_offset_m);
+  if (const auto& r = report.positioning.reproducibility) {
+    if (r->with_device)
+      std::printf("tumour spread over %d postures with the device: std %.3f mm, max %.3f mm\n", r->with_device->runs,
+                  1e3 * r->with_device->std_m, 1e3 * r->with_device->max_m);
+    std::printf("tumour spread over %d postures without a device: std %.3f mm, max %.3f mm\n", r->without_device.runs,
+                1e3 * r->without_device.std_m, 1e3 * r->without_device.max_m);
+  }
   std::printf("wrote %s/summary.json\nwrote %s/metrics.csv\nwrote %s/result.h5\n", o.out.c_str(), o.out.c_str(),
               o.out.c_str());
   if (report.image_outputs) std::printf("wrote DVF, warped CT and fields on the CT grid in %s/\n", o.out.c_str());

@@ -58,6 +58,11 @@ nlohmann::json write_mesh_outputs(const std::string& dir, const Lattice& lattice
   write_surface_ply(dir + "/surface.ply", mesh, state.position_m);
   write_lattice_vtu(dir + "/lattice.vtu", lattice, state.position_m, state.displacement_m, fields);
   nlohmann::json files = {"surface_rest.vtp", "surface.vtp", "surface.stl", "surface.ply", "lattice.vtu"};
+  if (!state.rest_offset_m.empty()) {  // the estimated unloaded shape, offsets from the CT as data
+    write_surface_vtp(dir + "/surface_unloaded.vtp", mesh, element_positions_m(lattice, state.rest_offset_m),
+                      state.rest_offset_m);
+    files.push_back("surface_unloaded.vtp");
+  }
   if (!frames.time_s.empty())
     for (const std::string& pvd : write_frame_series(dir, mesh, lattice, frames)) files.push_back(pvd);
   return {{"files", files},

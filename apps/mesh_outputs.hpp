@@ -9,7 +9,8 @@
 
 namespace vb::app {
 
-/// Writes surface_rest.vtp, surface.vtp, surface.stl, surface.ply and lattice.vtu into `dir`, and
+/// Writes surface_rest.vtp, surface.vtp, surface.stl, surface.ply and lattice.vtu into `dir` (and
+/// surface_unloaded.vtp with an unloaded reference state), and
 /// with displacement frames ParaView time series: frames/surface_NNNN.vtp, frames/lattice_NNNN.vtu,
 /// surface.pvd and lattice.pvd;
 /// returns what was written and the mesh counts (for summary.json).

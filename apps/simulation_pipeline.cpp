@@ -1,11 +1,14 @@
 #include "apps/simulation_pipeline.hpp"
 
+#include <cstdio>
 #include <mutex>
+#include <optional>
 
 #include "apps/device_mesh_outputs.hpp"
 #include "apps/image_outputs.hpp"
 #include "apps/mesh_outputs.hpp"
 #include "io/atomic_file.hpp"
+#include "io/csv_table.hpp"
 #include "io/hdf5_result.hpp"
 #include "io/json_summary.hpp"
 #include "io/metrics_csv.hpp"
@@ -19,6 +22,21 @@ std::mutex& file_io_mutex() {
   return mutex;
 }
 
+/// reproducibility.csv: one row per perturbed run (angles in degrees, centroid in mm).
+void write_reproducibility_csv(const std::string& path, const ReproducibilityResult& r) {
+  std::string text = csv_line({"run", "device", "roll_deg", "pitch_deg", "yaw_deg", "tumour_x_mm", "tumour_y_mm",
+                               "tumour_z_mm", "converged", "steps"});
+  for (const PerturbedRun& p : r.runs) {
+    std::vector<std::string> row = {std::to_string(p.index), p.device ? "1" : "0"};
+    for (int c = 0; c < 3; ++c) row.push_back(shortest_number_text(p.rpy_deg[c]));
+    for (int c = 0; c < 3; ++c) row.push_back(shortest_number_text(1e3 * p.tumour_centroid_m[c]));
+    row.push_back(p.converged ? "1" : "0");
+    row.push_back(std::to_string(p.steps));
+    text += csv_line(row);
+  }
+  write_text_atomically(path, text);
+}
+
 }  // namespace
 
 SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const std::string& out_dir,
@@ -28,18 +46,44 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
   io.unlock();
   check_positioning(scene, model.lattice);  // a misnamed tumour tissue fails now, not after the run
   Simulator sim(scene, model.lattice, model.elements, cl);
+  std::optional<ReferenceState> reference;
+  if (scene.reference_state.active) {  // the run starts from the CT resting on the unloaded state
+    reference = estimate_reference_state(scene, model.lattice, cl, options.on_reference_iteration);
+    sim.set_rest_offsets(reference->rest_offset_m);
+  }
   if (options.on_start) options.on_start(model, sim);
-  const RunOutput result = run_simulation(scene, model.lattice, model.elements, sim, options.on_progress);
+  RunOutput result = run_simulation(scene, model.lattice, model.elements, sim, options.on_progress);
+  if (reference) result.state.rest_offset_m = reference->rest_offset_m;
+  std::optional<ReproducibilityResult> repro;
+  if (scene.reproducibility.active)
+    repro = run_reproducibility(scene, model.lattice, cl, reference ? &reference->rest_offset_m : nullptr,
+                                options.on_perturbed_run);
 
   SimulationReport report;
   report.summary = result.summary;
   report.warnings = model.warnings;
+  if (reference && !reference->converged) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "the unloaded reference state is %.3g mm from the CT after %zu iterations (tolerance %.3g mm)",
+                  1e3 * reference->residual_max_m, reference->history.size(), 1e3 * scene.reference_state.tolerance_m);
+    report.warnings.push_back(text);
+  }
   io.lock();
   nlohmann::json summary = summary_to_json(result.summary, scene);
   report.positioning = compute_positioning_metrics(scene, model.lattice, model.elements, result.summary, result.state);
+  if (reference) {
+    report.positioning.reference_state = ReferenceStateMetrics{int(reference->history.size()), reference->converged,
+                                                               reference->residual_max_m, reference->residual_rms_m,
+                                                               reference->max_rest_offset_m};
+    summary["reference_state"] = reference_state_to_json(*reference, scene.reference_state);
+  }
+  report.positioning.reproducibility = repro;
   summary["positioning"] = positioning_to_json(report.positioning);
+  if (repro) summary["positioning"]["reproducibility"] = reproducibility_to_json(*repro, scene.reproducibility);
   write_metrics_csv(out_dir + "/metrics.csv", result.summary, report.positioning);
   if (options.full_outputs) {
+    if (repro) write_reproducibility_csv(out_dir + "/reproducibility.csv", *repro);
     write_result_h5(out_dir + "/result.h5", model.lattice, scene, result.state, result.frames, result.summary);
     if (model.ct) {
       summary["image_outputs"] = write_image_outputs(out_dir, scene, model.lattice, *model.ct, result.state);
@@ -53,7 +97,7 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
       report.mesh_outputs = true;
     }
   }
-  if (model.ct) summary["warnings"] = model.warnings;
+  if (model.ct || !report.warnings.empty()) summary["warnings"] = report.warnings;
   write_text_atomically(out_dir + "/summary.json", summary.dump(2) + "\n");
   return report;
 }

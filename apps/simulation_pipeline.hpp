@@ -8,6 +8,7 @@
 #include "apps/simulation_setup.hpp"
 #include "engine/study/positioning_metrics.hpp"
 #include "engine/sim/opencl_runtime.hpp"
+#include "engine/sim/reference_state.hpp"
 #include "engine/sim/run.hpp"
 
 namespace vb::app {
@@ -19,6 +20,10 @@ struct SimulationOptions {
   /// Called once the model is built and the simulator is ready, before the run.
   std::function<void(const PreparedModel&, const Simulator&)> on_start;
   std::function<void(const RunProgress&)> on_progress;
+  /// [reference_state]: after each forward solve of the unloaded state's estimate
+  std::function<void(const ReferenceIteration&)> on_reference_iteration;
+  /// [reproducibility]: after each perturbed run
+  std::function<void(const PerturbedRun&)> on_perturbed_run;
 };
 
 struct SimulationReport {

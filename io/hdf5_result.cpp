@@ -278,6 +278,7 @@ void write_state(const Object& root, const FinalState& state, hsize_t n) {
   write_dataset(group, "volumetric_strain", state.volumetric_strain, {n});
   write_dataset(group, "equivalent_strain", state.equivalent_strain, {n});
   write_dataset(group, "von_mises_stress_pa", state.von_mises_stress_pa, {n});
+  if (!state.rest_offset_m.empty()) write_dataset(group, "rest_offset_m", state.rest_offset_m, {n, 3});
 }
 
 /// Frames are written one at a time into an (F, n, 3) dataset, so a long run's frames are

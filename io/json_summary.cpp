@@ -93,6 +93,51 @@ json positioning_to_json(const PositioningMetrics& m) {
   return out;
 }
 
+json spread_to_json(const TumourSpread& s) {
+  return {{"runs", s.runs},
+          {"mean_m", vec3(s.mean_m)},
+          {"std_axis_m", vec3(s.std_axis_m)},
+          {"std_m", number(s.std_m)},
+          {"max_m", number(s.max_m)}};
+}
+
+json reproducibility_to_json(const ReproducibilityResult& r, const ReproducibilitySpec& spec) {
+  json runs = json::array();
+  for (const PerturbedRun& run : r.runs)
+    runs.push_back({{"index", run.index},
+                    {"device", run.device},
+                    {"rpy_deg", vec3(run.rpy_deg)},
+                    {"tumour_centroid_m", vec3(run.tumour_centroid_m)},
+                    {"converged", run.converged},
+                    {"steps", run.steps}});
+  return {{"perturbations", spec.perturbations},
+          {"max_angle_deg", spec.max_angle_deg},
+          {"seed", spec.seed},
+          {"with_device", r.with_device ? spread_to_json(*r.with_device) : json(nullptr)},
+          {"without_device", spread_to_json(r.without_device)},
+          {"runs", runs}};
+}
+
+json reference_state_to_json(const ReferenceState& r, const ReferenceStateSpec& spec) {
+  json history = json::array();
+  for (const ReferenceIteration& it : r.history)
+    history.push_back({{"iteration", it.iteration},
+                       {"residual_max_m", number(it.residual_max_m)},
+                       {"residual_rms_m", number(it.residual_rms_m)},
+                       {"steps", it.steps}});
+  return {{"ct_posture", spec.ct_posture.empty() ? json(nullptr) : json(spec.ct_posture)},
+          {"ct_gravity_m_s2", vec3(spec.ct_gravity_m_s2)},
+          {"tolerance_m", number(spec.tolerance_m)},
+          {"converged", r.converged},
+          {"iterations", r.history.size()},
+          {"residual_max_m", number(r.residual_max_m)},
+          {"residual_rms_m", number(r.residual_rms_m)},
+          {"max_rest_offset_m", number(r.max_rest_offset_m)},
+          {"steps", r.steps},
+          {"wall_time_s", number(r.wall_time_s)},
+          {"history", history}};
+}
+
 json summary_to_json(const RunSummary& s, const Scene& scene) {
   return {
       {"version", config::version},

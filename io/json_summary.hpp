@@ -4,6 +4,7 @@
 #include <string>
 
 #include "engine/scene/scene.hpp"
+#include "engine/sim/reference_state.hpp"
 #include "engine/sim/run_result.hpp"
 #include "engine/study/positioning_metrics.hpp"
 
@@ -14,6 +15,12 @@ nlohmann::json summary_to_json(const RunSummary& summary, const Scene& scene);
 
 /// The `positioning` section of summary.json (docs/OUTPUTS.md); absent parts are null.
 nlohmann::json positioning_to_json(const PositioningMetrics& metrics);
+
+/// summary.json's `reference_state` (the unloaded state's estimate and its iterations).
+nlohmann::json reference_state_to_json(const ReferenceState& state, const ReferenceStateSpec& spec);
+
+/// The `positioning.reproducibility` section: the spreads with and without the device, each run.
+nlohmann::json reproducibility_to_json(const ReproducibilityResult& result, const ReproducibilitySpec& spec);
 
 /// Writes summary_to_json() to `path` atomically (temporary file + rename); throws vb::Error.
 void write_summary_json(const std::string& path, const RunSummary& summary, const Scene& scene);

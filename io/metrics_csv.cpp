@@ -66,6 +66,17 @@ std::vector<std::pair<std::string, std::string>> metrics_row(const RunSummary& s
   add("breast_chest_wall_max_distance_rest_mm", c ? number(kMm * c->max_rest_m) : "");
   add("breast_chest_wall_max_distance_mm", c ? number(kMm * c->max_final_m) : "");
 
+  if (const auto& r = m.reference_state) {  // scenes with [reference_state] only
+    add("reference_state_iterations", std::to_string(r->iterations));
+    add("reference_state_residual_max_mm", number(kMm * r->residual_max_m));
+    add("reference_state_max_offset_mm", number(kMm * r->max_rest_offset_m));
+  }
+  if (const auto& r = m.reproducibility) {  // scenes with [reproducibility] only
+    add("tumour_spread_std_device_mm", r->with_device ? number(kMm * r->with_device->std_m) : "");
+    add("tumour_spread_max_device_mm", r->with_device ? number(kMm * r->with_device->max_m) : "");
+    add("tumour_spread_std_no_device_mm", number(kMm * r->without_device.std_m));
+    add("tumour_spread_max_no_device_mm", number(kMm * r->without_device.max_m));
+  }
   add("peak_equivalent_strain", number(m.comfort.peak_equivalent_strain));
   add("p95_equivalent_strain", number(m.comfort.p95_equivalent_strain));
   add("peak_von_mises_stress_pa", number(m.comfort.peak_von_mises_pa));

@@ -826,6 +826,45 @@ VolumeSpec read_volume(const Section& s) {
   return volume;
 }
 
+ReferenceStateSpec read_reference_state(const Section& s) {
+  s.check_keys({"ct_posture", "ct_gravity", "tolerance_mm", "max_iterations"});
+  ReferenceStateSpec r;
+  r.active = true;
+  r.line = s.line();
+  const std::optional<std::string> posture = s.text("ct_posture");
+  const std::optional<Vec3> vector = s.vec3("ct_gravity");
+  if (posture && vector) s.fail("ct_gravity", "give either 'ct_posture' or 'ct_gravity', not both");
+  if (!posture && !vector)
+    s.fail("ct_posture", "[reference_state] needs the CT's posture", "e.g. ct_posture = \"supine\"");
+  if (vector) r.ct_gravity_m_s2 = *vector;
+  if (posture) {
+    try {
+      r.ct_gravity_m_s2 = gravity_for_posture(*posture);
+    } catch (const Error& e) {
+      s.fail("ct_posture", e.problem(), e.hint());
+    }
+    r.ct_posture = *posture;
+  }
+  if (const auto mm = s.positive("tolerance_mm")) r.tolerance_m = *mm * 1e-3;
+  r.max_iterations = s.integer<int>("max_iterations", 1).value_or(r.max_iterations);
+  return r;
+}
+
+ReproducibilitySpec read_reproducibility(const Section& s, const std::vector<AnchorSpec>& anchors) {
+  s.check_keys({"perturbations", "max_angle_deg", "seed"});
+  ReproducibilitySpec r;
+  r.active = true;
+  r.line = s.line();
+  r.perturbations = s.integer<int>("perturbations", 2).value_or(r.perturbations);
+  r.max_angle_deg = s.positive("max_angle_deg").value_or(r.max_angle_deg);
+  if (r.max_angle_deg > 45) s.fail("max_angle_deg", "is meant for small day-to-day posture changes", "use at most 45");
+  r.seed = std::uint64_t(s.integer<std::int64_t>("seed", 0).value_or(std::int64_t(r.seed)));
+  if (std::none_of(anchors.begin(), anchors.end(), [](const AnchorSpec& a) { return a.kind == AnchorSpec::Kind::Sphere; }))
+    s.fail("perturbations", "perturbs the pose of the chest-wall sphere anchor, and the scene has none",
+           "add [anchor.NAME] kind = \"sphere\" (docs/POSITIONING.md)");
+  return r;
+}
+
 OutputSpec read_output(const Section& s, const ModelSpec& model) {
   s.check_keys({"frames_every", "dvf", "warped_ct", "warped_ct_dicom", "fields", "surfaces"});
   OutputSpec out;
@@ -892,7 +931,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
   const Section top(root, "", source_name);
   top.check_keys(
       {"model", "materials", "solver", "gravity", "anchor", "indenter", "device", "positioning", "track", "stop",
-       "output", "volume"});
+       "output", "volume", "reference_state", "reproducibility"});
   Scene scene;
   scene.model = read_model(top.table_or_empty("model"));
   scene.materials = read_materials(top.table_or_empty("materials"));
@@ -908,6 +947,10 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
   scene.stop = read_stop(top.table_or_empty("stop"));
   scene.output = read_output(top.table_or_empty("output"), scene.model);
   if (const auto volume = top.table("volume")) scene.volume = read_volume(*volume);
+  if (const auto r = top.table("reference_state")) scene.reference_state = read_reference_state(*r);
+  if (const auto r = top.table("reproducibility")) scene.reproducibility = read_reproducibility(*r, scene.anchors);
+  if (scene.reference_state.active && !scene.gravity.active)
+    top.fail("reference_state", "[reference_state] needs a [gravity] section: the posture the run goes to");
   check_labels(scene, source_name);
   scene.source_text = text;
   return scene;

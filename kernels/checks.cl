@@ -14,7 +14,7 @@
 // into the tube (m, max).
 // With VB_RELAX (dynamic relaxation, kernels/relax.cl) four more sums follow: Rayleigh quotients,
 // each ≥ the lowest mode's ω², that the host sets the damping from (Underwood). One is of the
-// displacement u (the lattice force is zero at rest), one of the change Δu since the previous
+// displacement u from rest (the lattice force is zero there), one of the change Δu since the previous
 // check (stored in relax_prev with the lattice force then), which late in a relaxation is the
 // slowest mode itself. With R = VB_RELAX_SLOT0 (after the tori's slots):
 //   R     uᵀKu = −Σ u·f_lattice(u)          R + 1  uᵀM̃u = Σ m̃|u|²
@@ -99,8 +99,13 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
 #endif
       const real4 du = xyz0(ui) - relax_prev[2 * e];
       const real scaled_mass = 1 / (ui.w * relax_scale[e]);
-      value[R] = -dot3(ui, f_lattice);
-      value[R + 1] = dot3(ui, ui) * scaled_mass;
+#if VB_REST_OFFSET
+      const real4 from_rest = xyz0(ui - rest_offset[e]);  // the lattice force is zero there
+#else
+      const real4 from_rest = xyz0(ui);
+#endif
+      value[R] = -dot3(from_rest, f_lattice);
+      value[R + 1] = dot3(from_rest, from_rest) * scaled_mass;
       value[R + 2] = -dot3(du, f_lattice - relax_prev[2 * e + 1]);
       value[R + 3] = dot3(du, du) * scaled_mass;
       relax_prev[2 * e] = xyz0(ui);

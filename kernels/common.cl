@@ -9,6 +9,8 @@
 //   -DVB_VOLUME=0|1   volume-preservation constraint on (kernels/volume.cl)
 //   -DVB_RELAX=0|1    dynamic relaxation (kernels/relax.cl): four more check slots
 //   -DVB_TORI=count, -DVB_TORUS_BASE=N, -DVB_FRICTION=0|1  the torus device (kernels/device_contact.cl)
+//   -DVB_REST_OFFSET=0|1  the rest state is not the lattice: element e rests at its voxel centre
+//                     plus rest_offset[e] (the unloaded reference state, docs/PHYSICS.md §13)
 // and prepends the lattice tables (VB_DIR, VB_DIR_LEN, VB_KAPPA) generated from the host's
 // single definition (engine/sim/kernel_tables.cpp).
 #if VB_DOUBLE
@@ -38,14 +40,16 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
 
 // Parameters every stepping kernel takes, in this order (the host sets them in one place).
 // Hyperelastic data (tissue_of, materials, Qs, Fs, hourglass) are 1-element placeholders when
-// VB_HYPER is 0; tissue_of and materials are real when VB_BIPHASIC is 1.
+// VB_HYPER is 0; tissue_of and materials are real when VB_BIPHASIC is 1; rest_offset (m, lattice
+// frame) is a placeholder when VB_REST_OFFSET is 0.
 #define VB_LATTICE_PARAMS                                                                        \
   global const real *E, global const uint *cell_of, global const int *grid, int sy, int sz,    \
       real h, real dashpot_ratio, real4 gravity, real damping, real4 origin,                   \
       global const uchar *tissue_of, global const real *materials, global const real4 *Qs,     \
-      global const real4 *Fs, real hourglass
+      global const real4 *Fs, real hourglass, global const real4 *rest_offset
 #define VB_LATTICE_ARGS \
-  E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity, damping, origin, tissue_of, materials, Qs, Fs, hourglass
+  E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity, damping, origin, tissue_of, materials, Qs, Fs, hourglass, \
+      rest_offset
 // Rigid indenters: a table of VB_INDENTERS rows (lattice frame, VB_IND_STRIDE reals each:
 // 0–2 start (m), 3 radius (m; < 0 for a plate), 4–6 plate normal into the tissue, 8–10
 // velocity (m/s), 12 travel time (s), 13 contact: 0 push, 1 slide, 2 stick), the time forces are

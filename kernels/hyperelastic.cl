@@ -51,6 +51,13 @@ inline mat3 mat3_transpose_mul(mat3 a, mat3 b) {  // aᵀ·b
   return r;
 }
 
+inline mat3 mat3_transpose(mat3 a) {
+  mat3 r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[j][i];
+  return r;
+}
+
 inline real mat3_det(mat3 a) {
   return a.m[0][0] * (a.m[1][1] * a.m[2][2] - a.m[1][2] * a.m[2][1]) -
          a.m[0][1] * (a.m[1][0] * a.m[2][2] - a.m[1][2] * a.m[2][0]) +
@@ -201,21 +208,11 @@ inline mat3 stress_ogden(mat3 C, real J, global const real* mat) {
   return S;
 }
 
-// Pass 1: per-element F and Q (rows of 3×3 matrices stored as 3 real4 each). The element's volume
-// is w·h³, w = (complete dual cells around it)/8 (engine/lattice/dual_cells.hpp): then a
-// homogeneous stress is balanced by forces on the surface elements alone, as plates apply them.
-kernel void element_stress(global const real4* u, global const uchar* tissue_of, global const real* materials,
-                           global const uint* cell_of, global const int* grid, int sy, int sz, real h,
-                           global real4* Q_out, global real4* F_out, uint n) {
-  const uint e = get_global_id(0);
-  if (e >= n) return;
-  global const real* mat = materials + VB_MAT_STRIDE * tissue_of[e];
-  const int law = (int)mat[0];
-  if (!VB_LAW_HYPER(law)) {  // spring tissue: no element stress
-    mat3_store(Q_out, e, mat3_zero());
-    mat3_store(F_out, e, mat3_identity());
-    return;
-  }
+// Least-squares deformation gradient of element e from the displacements u of its existing
+// neighbours: F = A·B⁻¹ (see the top of this file). Sets B⁻¹ (in units of 1/h²) and the bit mask
+// of present neighbours; returns false when they do not span 3-D (a thin strand: no F).
+inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_of, global const int* grid,
+                         int sy, int sz, real h, mat3* F, mat3* Bi, uint* present_out) {
   const int cell = (int)cell_of[e];
   const real4 ue = u[e];
   mat3 A = mat3_zero(), B = mat3_zero();  // B in units of h²
@@ -233,16 +230,44 @@ kernel void element_stress(global const real4* u, global const uchar* tissue_of,
         B.m[a][b] += dX[a] * dX[b];
       }
   }
+  *present_out = present;
   const real detB = mat3_det(B);
-  if (detB < (real)0.5) {  // neighbours do not span 3-D (a thin strand): no element stress
+  if (detB < (real)0.5) return false;
+  *Bi = mat3_inverse(B, detB);
+  *F = mat3_mul(A, *Bi);
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) F->m[a][b] /= h;
+  return true;
+}
+
+// Pass 1: per-element F and Q (rows of 3×3 matrices stored as 3 real4 each). The element's volume
+// is w·h³, w = (complete dual cells around it)/8 (engine/lattice/dual_cells.hpp): then a
+// homogeneous stress is balanced by forces on the surface elements alone, as plates apply them.
+// With VB_REST_OFFSET the element rests in the unloaded state, whose gradient from the lattice is
+// F₀ (rest_frame: rows of R₀ = F₀⁻¹, J₀ = det F₀ in row 0's w): the law sees F·R₀ and the energy
+// J₀·V·W(F·R₀) gives Q = J₀·V·P(F·R₀)·R₀ᵀ·B⁻¹ on the same lattice offsets. F_out is the
+// deformation from rest (F·R₀), which the hourglass control applies to the rest connections.
+kernel void element_stress(global const real4* u, global const uchar* tissue_of, global const real* materials,
+                           global const uint* cell_of, global const int* grid, int sy, int sz, real h,
+                           global real4* Q_out, global real4* F_out, uint n, global const real4* rest_frame) {
+  const uint e = get_global_id(0);
+  if (e >= n) return;
+  global const real* mat = materials + VB_MAT_STRIDE * tissue_of[e];
+  const int law = (int)mat[0];
+  mat3 F, Bi;
+  uint present = 0;
+  // spring tissue, or neighbours that do not span 3-D: no element stress
+  if (!VB_LAW_HYPER(law) || !fit_gradient(u, e, cell_of, grid, sy, sz, h, &F, &Bi, &present)) {
     mat3_store(Q_out, e, mat3_zero());
     mat3_store(F_out, e, mat3_identity());
     return;
   }
-  const mat3 Bi = mat3_inverse(B, detB);
-  mat3 F = mat3_mul(A, Bi);
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) F.m[a][b] /= h;
+#if VB_REST_OFFSET
+  const mat3 R0 = mat3_load(rest_frame, e);
+  const real J0 = rest_frame[3 * e].w;
+  F = mat3_mul(F, R0);
+#endif
+  mat3_store(F_out, e, F);
   const real J = mat3_det(F);
   const mat3 C = mat3_transpose_mul(F, F);
   const mat3 S = law == 1 ? stress_invariants(C, J, (real)0.5 * mat[2], (real)-0.5 * mat[3])
@@ -252,6 +277,11 @@ kernel void element_stress(global const real4* u, global const uchar* tissue_of,
   const real vol = mat[8] * (J - 1);
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) P.m[a][b] += vol * cof.m[a][b];
+#if VB_REST_OFFSET
+  P = mat3_mul(P, mat3_transpose(R0));
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) P.m[a][b] *= J0;
+#endif
   int cells = 0;
   for (int o = 0; o < 8; ++o) cells += (present & VB_OCTANT_MASK[o]) == VB_OCTANT_MASK[o];
   mat3 Q = mat3_mul(P, Bi);  // V·P·B⁻¹ with V = w·h³ and B = h²·B' → w·h·P·B'⁻¹
@@ -259,6 +289,28 @@ kernel void element_stress(global const real4* u, global const uchar* tissue_of,
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) Q.m[a][b] *= wh;
   mat3_store(Q_out, e, Q);
-  mat3_store(F_out, e, F);
 }
+
+#if VB_REST_OFFSET
+// The unloaded state's frame per element, once per rest state: R₀ = F₀⁻¹ (rows, 3 real4) and
+// J₀ = det F₀ (row 0's w), F₀ the same least-squares fit of the rest offsets u0 (identity for
+// spring tissue and thin strands, which element_stress does not use).
+kernel void rest_frame(global const real4* u0, global const uchar* tissue_of, global const real* materials,
+                       global const uint* cell_of, global const int* grid, int sy, int sz, real h,
+                       global real4* frame_out, uint n) {
+  const uint e = get_global_id(0);
+  if (e >= n) return;
+  const int law = (int)materials[VB_MAT_STRIDE * tissue_of[e]];
+  mat3 F0, Bi;
+  uint present = 0;
+  real J0 = 1;
+  mat3 R0 = mat3_identity();
+  if (VB_LAW_HYPER(law) && fit_gradient(u0, e, cell_of, grid, sy, sz, h, &F0, &Bi, &present)) {
+    J0 = mat3_det(F0);
+    R0 = mat3_inverse(F0, J0);
+  }
+  mat3_store(frame_out, e, R0);
+  frame_out[3 * e].w = J0;
+}
+#endif
 #endif  // VB_HYPER

@@ -29,8 +29,9 @@ inline real spring_end(int law, global const real* mat, real k, real len, real r
 // Hyperelastic tissues (VB_HYPER): the element stresses of pass 1 (Q·h·d from each neighbour,
 // Q_e·Σh·d from the element itself) plus hourglass control. Per connection, each end adds half a
 // spring: a linear end ½k(|r| − L), a biphasic end ½k·L·g(ε) (VB_BIPHASIC), a hyperelastic end
-// c_hg·k(|r| − |F·h·d|), whose rest length is the length its own affine fit predicts, so affine
-// fields feel no hourglass force.
+// c_hg·k(|r| − |F·r₀|), whose rest length is the length its own affine fit predicts, so affine
+// fields feel no hourglass force (r₀ the connection at rest: h·d, or h·d + Δu0 with rest offsets,
+// F the element's deformation from rest).
 // u: displacement (m) with w = inverse mass (1/kg, 0 = held); v: velocity (m/s).
 real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v, VB_LATTICE_PARAMS) {
   const int cell = (int)cell_of[e];
@@ -43,6 +44,9 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
 #if VB_HYPER
   const mat3 Fi = mat3_load(Fs, e);
   real4 own_offsets = (real4)(0);
+#endif
+#if VB_REST_OFFSET
+  const real4 u0i = rest_offset[e];
 #endif
 #pragma unroll
   for (int d = 0; d < 26; ++d) {
@@ -65,16 +69,24 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
     const real4 n = r * inv_len;
     const real Ej = E[j];
     const real k = present * VB_KAPPA[d] * h * (2 * Ei * Ej / (Ei + Ej));
+#if VB_REST_OFFSET
+    // The connection's rest vector in the unloaded state: h·d plus the change of the two ends'
+    // rest offsets (a missing neighbour reads the element itself: h·d, masked out above).
+    const real4 r0 = hd + xyz0(rest_offset[j] - u0i);
+    const real rest = sqrt(dot3(r0, r0));
+#else
+    const real4 r0 = hd;
     const real rest = h * VB_DIR_LEN[d];
+#endif
 #if VB_HYPER || VB_BIPHASIC
     global const real* mat_j = materials + VB_MAT_STRIDE * tissue_of[j];
     const int law_j = (int)mat_j[0];
 #endif
 #if VB_HYPER
     real magnitude = !VB_LAW_HYPER(law_i) ? spring_end(law_i, mat_i, k, len, rest)
-                                          : hourglass * k * (len - length(mat3_apply(Fi, hd)));
+                                          : hourglass * k * (len - length(mat3_apply(Fi, r0)));
     magnitude += !VB_LAW_HYPER(law_j) ? spring_end(law_j, mat_j, k, len, rest)
-                                      : hourglass * k * (len - length(mat3_apply(mat3_load(Fs, (uint)j), hd)));
+                                      : hourglass * k * (len - length(mat3_apply(mat3_load(Fs, (uint)j), r0)));
     if (VB_LAW_HYPER(law_j)) f += present * mat3_apply(mat3_load(Qs, (uint)j), hd);
     own_offsets += present * hd;
 #elif VB_BIPHASIC

@@ -180,6 +180,28 @@ struct VolumeSpec {
   int line = 0;
 };
 
+/// The unloaded reference state ([reference_state], docs/PHYSICS.md §13): the CT was taken under
+/// gravity, so the rest shape is estimated — rest positions that, loaded by the CT posture's
+/// gravity, land on the CT — and the run starts from the CT in equilibrium on that rest shape.
+struct ReferenceStateSpec {
+  bool active = false;
+  Vec3 ct_gravity_m_s2 = Vec3::Zero();  ///< gravity when the CT was taken (body frame)
+  std::string ct_posture;               ///< its posture name when given by name
+  double tolerance_m = 1e-5;            ///< stop when no element lands farther than this from the CT
+  int max_iterations = 20;
+  int line = 0;
+};
+
+/// Reproducibility of a positioning ([reproducibility], docs/POSITIONING.md): the run repeated
+/// under random roll/pitch/yaw of the chest-wall anchor, with and without the device.
+struct ReproducibilitySpec {
+  bool active = false;
+  int perturbations = 8;       ///< N perturbed runs per configuration
+  double max_angle_deg = 1.0;  ///< each of roll, pitch, yaw uniform in [−θ, θ]
+  std::uint64_t seed = 1;      ///< of the angle sequence (the same seed gives the same angles)
+  int line = 0;
+};
+
 struct Scene {
   ModelSpec model;
   std::map<std::string, MaterialSpec> materials;
@@ -193,6 +215,8 @@ struct Scene {
   StopSpec stop;
   OutputSpec output;
   VolumeSpec volume;
+  ReferenceStateSpec reference_state;
+  ReproducibilitySpec reproducibility;
   std::string source_path;  ///< file the scene came from (for messages)
   std::string source_text;  ///< the scene file text, stored with results
 };

@@ -73,6 +73,9 @@ struct FinalState {
   std::vector<double> volumetric_strain; ///< n, det F − 1
   std::vector<double> equivalent_strain; ///< n, von Mises equivalent of Green-Lagrange strain
   std::vector<double> von_mises_stress_pa;  ///< n, small-strain linear-lattice stress (Pa)
+  /// n×3 (m): the unloaded reference state as offsets from the voxel centres ([reference_state]);
+  /// empty without one
+  std::vector<double> rest_offset_m;
 };
 
 /// Optional displacement frames (every `frames_every` steps).

@@ -19,7 +19,7 @@ constexpr int kCheckSlotsPerTorus = 8;                             // VB_TORUS_S
 constexpr int kIndenterStride = 16;                                // VB_IND_STRIDE
 constexpr int kTorusStride = 12;                                   // VB_TORUS_STRIDE
 // Kernel argument layout (kernels/common.cl): VB_LATTICE_PARAMS then VB_INDENTER_PARAMS.
-constexpr int kLatticeArgs = 15, kIndenterArgs = 3;
+constexpr int kLatticeArgs = 16, kIndenterArgs = 3;
 constexpr int kStepLattice = 4;                              // step kernels: 4 state buffers first
 constexpr int kStepIndenter = kStepLattice + kLatticeArgs;   // then dt, n
 constexpr int kCheckLattice = 2;                             // check_state: u, v first
@@ -144,6 +144,15 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   for (cl::Buffer* b : {&u_, &v_, &u_tmp_, &v_tmp_}) *b = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
   upload(el.displacement_m, std::vector<double>(3 * n_, 0.0));
   make_hyperelastic_buffers(el);
+  // The unloaded reference state: rest offsets (zero until set_rest_offsets), and for
+  // hyperelastic tissue the rest frame R₀, J₀ (kernels/hyperelastic.cl); placeholders otherwise.
+  rest_offsets_ = scene.reference_state.active;
+  const std::size_t offset_bytes = (rest_offsets_ ? n_ : 1) * 4 * real_size_;
+  const std::size_t frame_bytes = (rest_offsets_ && hyper_ ? 3 * n_ : 1) * 4 * real_size_;
+  if (rest_offsets_) device_bytes_ += offset_bytes + (hyper_ ? frame_bytes : 0);
+  std::vector<char> blank(std::max(offset_bytes, frame_bytes), 0);
+  rest_offset_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, offset_bytes, blank.data());
+  rest_frame_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, frame_bytes, blank.data());
 
   const std::size_t wg = kCheckWorkGroup;
   check_groups_ = (n_ + wg - 1) / wg;
@@ -190,6 +199,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_TORI=" + std::to_string(scene.tori.size());
   options += " -DVB_TORUS_BASE=" + std::to_string(torus_table_base());
   options += " -DVB_FRICTION=" + std::to_string(friction);
+  options += " -DVB_REST_OFFSET=" + std::to_string(rest_offsets_);
   std::vector<std::string> sources = {"common.cl", "hyperelastic.cl", "lattice_forces.cl", "device_contact.cl",
                                       "integrate.cl"};
   if (volume_) sources.push_back("volume.cl");
@@ -208,6 +218,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     stress_.setArg(8, Q_);
     stress_.setArg(9, F_);
     stress_.setArg(10, cl_uint(n_));
+    stress_.setArg(11, rest_frame_);
   }
 
   const bool heun = scene.solver.integrator == Integrator::Heun;
@@ -249,6 +260,49 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   }
   if (volume_) make_volume_buffers(surface_);
   if (!scene.tori.empty()) make_contact_area_buffer();
+  if (rest_offsets_) set_rest_offsets(std::vector<double>(3 * n_, 0.0));  // R₀ = I, J₀ = 1
+}
+
+void Simulator::set_rest_offsets(const std::vector<double>& u0) {
+  require(rest_offsets_, "rest offsets need a scene with a [reference_state] section", "reference_state");
+  require(u0.size() == 3 * n_, "rest offsets do not match the model");
+  if (precision_ == Precision::Double) write_xyz<double>(rest_offset_, u0, nullptr);
+  else write_xyz<float>(rest_offset_, u0, nullptr);
+  if (hyper_) {
+    cl::Kernel k(program_, "rest_frame");
+    k.setArg(0, rest_offset_);
+    k.setArg(1, tissue_);
+    k.setArg(2, materials_);
+    k.setArg(3, cell_);
+    k.setArg(4, grid_);
+    k.setArg(5, cl_int(stride_y_));
+    k.setArg(6, cl_int(stride_z_));
+    set_real(k, 7, lattice_.spacing_m);
+    k.setArg(8, rest_frame_);
+    k.setArg(9, cl_uint(n_));
+    enqueue(k);
+  }
+  if (relax_) {  // the Rayleigh quotients' previous state: the rest state, where the force is zero
+    std::vector<double> prev(6 * n_, 0.0);
+    for (std::size_t e = 0; e < n_; ++e)
+      for (int c = 0; c < 3; ++c) prev[6 * e + c] = u0[3 * e + c];
+    std::vector<double> pairs = to_lattice_frame(prev);  // 2n vectors: u0_e, 0
+    if (precision_ == Precision::Double) {
+      auto data = pack4<double>(pairs, nullptr);
+      cl_.queue.enqueueWriteBuffer(relax_prev_, CL_TRUE, 0, data.size() * sizeof(double), data.data());
+    } else {
+      auto data = pack4<float>(pairs, nullptr);
+      cl_.queue.enqueueWriteBuffer(relax_prev_, CL_TRUE, 0, data.size() * sizeof(float), data.data());
+    }
+  }
+  if (volume_) {  // the constraint holds the unloaded state's volume
+    std::vector<double> rest = element_positions_m(lattice_), unloaded = rest;
+    for (std::size_t i = 0; i < unloaded.size(); ++i) unloaded[i] += u0[i];
+    const double lattice_volume = double(surface_.complete_cell_count) * std::pow(lattice_.spacing_m, 3);
+    rest_volume_m3_ = lattice_volume * vb::enclosed_volume_m3(surface_, unloaded) / vb::enclosed_volume_m3(surface_, rest);
+    set_real(vol_finish_, 2, frame_sign_ * rest_volume_m3_);
+  }
+  cl_.queue.finish();
 }
 
 void Simulator::make_contact_area_buffer() {
@@ -437,6 +491,7 @@ void Simulator::set_lattice_args(cl::Kernel& k, int a) {
   k.setArg(a + 12, Q_);
   k.setArg(a + 13, F_);
   set_real(k, a + 14, scene_.solver.hourglass);
+  k.setArg(a + 15, rest_offset_);
 }
 
 Vec3 Simulator::indenter_position(std::size_t i, double t) const {

@@ -64,6 +64,11 @@ class Simulator {
   StateCheck check();
   /// Changes gravity (world frame, m/s²) from the next step on: a posture change.
   void set_gravity(const Vec3& acceleration_m_s2);
+  /// The unloaded reference state (scenes with [reference_state] only): element e rests at its
+  /// voxel centre + u0[e] (n×3, m, world frame) instead of at its voxel centre; springs take
+  /// their rest lengths and hyperelastic elements their rest shape from it (docs/PHYSICS.md §13).
+  /// Displacements stay measured from the voxel centres (the CT). Zero until set.
+  void set_rest_offsets(const std::vector<double>& u0_m);
   /// Counts time from zero again (the next run starts at t = 0, indenters at their start).
   void restart_clock() { steps_ = 0; }
 
@@ -160,6 +165,8 @@ class Simulator {
   double relax_omega_sq_ = INFINITY;  ///< relaxation: smallest Rayleigh quotient so far (1/s²)
   Vec3 gravity_ = Vec3::Zero();
   cl::Buffer relax_scale_, relax_prev_;
+  bool rest_offsets_ = false;
+  cl::Buffer rest_offset_, rest_frame_;  ///< u0 per element; R₀ rows and J₀ (hyperelastic)
   mutable cl::Kernel check_;
 
   // Volume constraint ([volume] preserve): the surface mesh, uploaded once.

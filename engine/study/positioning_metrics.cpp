@@ -23,17 +23,6 @@ int tumour_tissue_index(const Scene& scene, const Lattice& lattice) {
   return -1;
 }
 
-const AnchorSpec* chest_wall_anchor(const Scene& scene) {
-  const std::string& name = scene.positioning.chest_wall;
-  const AnchorSpec* only_sphere = nullptr;
-  int spheres = 0;
-  for (const AnchorSpec& a : scene.anchors) {
-    if (!name.empty() && a.name == name) return &a;
-    if (a.kind == AnchorSpec::Kind::Sphere) only_sphere = &a, ++spheres;
-  }
-  return name.empty() && spheres == 1 ? only_sphere : nullptr;
-}
-
 /// Value at fraction q of the sorted values (nearest rank); 0 for none.
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return 0;
@@ -44,6 +33,17 @@ double quantile(std::vector<double> v, double q) {
 }
 
 }  // namespace
+
+const AnchorSpec* chest_wall_anchor(const Scene& scene) {
+  const std::string& name = scene.positioning.chest_wall;
+  const AnchorSpec* only_sphere = nullptr;
+  int spheres = 0;
+  for (const AnchorSpec& a : scene.anchors) {
+    if (!name.empty() && a.name == name) return &a;
+    if (a.kind == AnchorSpec::Kind::Sphere) only_sphere = &a, ++spheres;
+  }
+  return name.empty() && spheres == 1 ? only_sphere : nullptr;
+}
 
 void check_positioning(const Scene& scene, const Lattice& lattice) { (void)tumour_tissue_index(scene, lattice); }
 

@@ -9,6 +9,7 @@
 #include "engine/scene/scene.hpp"
 #include "engine/sim/element_setup.hpp"
 #include "engine/sim/run_result.hpp"
+#include "engine/study/reproducibility.hpp"
 
 namespace vb {
 
@@ -38,11 +39,21 @@ struct ComfortMetrics {
   double peak_von_mises_pa = 0, p95_von_mises_pa = 0;
 };
 
+/// The unloaded reference state's estimate ([reference_state]).
+struct ReferenceStateMetrics {
+  int iterations = 0;
+  bool converged = false;
+  double residual_max_m = 0, residual_rms_m = 0;  ///< how far the loaded estimate lands from the CT
+  double max_rest_offset_m = 0;                   ///< largest |u0|: unloaded shape vs CT
+};
+
 struct PositioningMetrics {
   std::optional<TumourMetrics> tumour;         ///< absent without a tumour tissue
   std::optional<ChestWallMetrics> chest_wall;  ///< absent without a chest-wall anchor
   ComfortMetrics comfort;
   double volume_change = 0, surface_volume_change = 0;  ///< fractions (RunSummary)
+  std::optional<ReferenceStateMetrics> reference_state;   ///< scenes with [reference_state]
+  std::optional<ReproducibilityResult> reproducibility;   ///< scenes with [reproducibility]
 };
 
 /// The tissue is [positioning] tumour_tissue, else "tumour" when the model has it; the chest wall
@@ -54,6 +65,10 @@ PositioningMetrics compute_positioning_metrics(const Scene& scene, const Lattice
 /// Throws the error compute_positioning_metrics would (a named tumour tissue the model lacks), so
 /// a run can fail before it starts rather than after.
 void check_positioning(const Scene& scene, const Lattice& lattice);
+
+/// The chest-wall anchor: [positioning] chest_wall, else the scene's only sphere anchor; nullptr
+/// when there is none (or several spheres and none named).
+const AnchorSpec* chest_wall_anchor(const Scene& scene);
 
 /// Signed distance of x from the anchor's surface (m), positive outside the held region; sphere
 /// and halfspace anchors only.

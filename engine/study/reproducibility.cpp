@@ -1,0 +1,106 @@
+#include "engine/study/reproducibility.hpp"
+
+#include <random>
+
+#include "engine/error.hpp"
+#include "engine/loads/anchors.hpp"
+#include "engine/sim/run.hpp"
+#include "engine/study/positioning_metrics.hpp"
+
+namespace vb {
+namespace {
+
+/// The start of a perturbed run: the whole patient turned rigidly with the chest wall (a posture
+/// change turns the body, not just the ribs), held elements at their prescribed pose.
+std::vector<double> turned_with_chest_wall(const Lattice& lattice, const ElementArrays& el, const AnchorSpec& wall) {
+  const Eigen::Matrix3d R = rotation_from_rpy_deg(wall.rpy_deg);
+  std::vector<double> u = el.displacement_m;
+  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+    if (el.inverse_mass[e] == 0) continue;
+    const Vec3 X = lattice.rest_position(e);
+    const Vec3 d = R * (X - wall.center_m) + wall.center_m - X;
+    for (int c = 0; c < 3; ++c) u[3 * e + c] = d[c];
+  }
+  return u;
+}
+
+}  // namespace
+
+std::vector<Vec3> perturbation_angles_deg(const ReproducibilitySpec& spec) {
+  std::mt19937_64 bits(spec.seed);
+  // [0, 1) from the top 53 bits: distributions are implementation-defined, the engine is not.
+  const auto uniform = [&] { return double(bits() >> 11) * 0x1.0p-53; };
+  std::vector<Vec3> angles(std::size_t(spec.perturbations));
+  for (Vec3& a : angles)
+    for (int c = 0; c < 3; ++c) a[c] = spec.max_angle_deg * (2 * uniform() - 1);
+  return angles;
+}
+
+TumourSpread tumour_spread(const std::vector<Vec3>& p) {
+  TumourSpread s;
+  s.runs = int(p.size());
+  if (p.empty()) return s;
+  for (const Vec3& x : p) s.mean_m += x;
+  s.mean_m /= double(p.size());
+  Vec3 var = Vec3::Zero();
+  for (const Vec3& x : p) {
+    const Vec3 d = x - s.mean_m;
+    var += d.cwiseProduct(d);
+    s.max_m = std::max(s.max_m, d.norm());
+  }
+  var /= double(p.size());
+  s.std_axis_m = var.cwiseSqrt();
+  s.std_m = std::sqrt(var.sum());
+  return s;
+}
+
+ReproducibilityResult run_reproducibility(const Scene& scene, const Lattice& lattice, const ClContext& cl,
+                                          const std::vector<double>* rest_offsets_m,
+                                          const std::function<void(const PerturbedRun&)>& on_run) {
+  const std::string where = "reproducibility (line " + std::to_string(scene.reproducibility.line) + ")";
+  const AnchorSpec* wall = chest_wall_anchor(scene);
+  require(wall && wall->kind == AnchorSpec::Kind::Sphere, "the chest wall to perturb is not a sphere anchor", where,
+          "name a sphere anchor in [positioning] chest_wall (docs/POSITIONING.md)");
+  const std::size_t wall_index = std::size_t(wall - scene.anchors.data());
+  const std::vector<Vec3> angles = perturbation_angles_deg(scene.reproducibility);
+
+  ReproducibilityResult out;
+  std::vector<Vec3> with, without;
+  for (const bool device : {true, false}) {
+    if (device && scene.tori.empty()) continue;
+    Scene config = scene;
+    if (!device) config.tori.clear();  // nothing of the device is built (kernels or buffers)
+    config.reproducibility = ReproducibilitySpec{};
+    config.output.frames_every = 0;
+    const ElementArrays base = make_element_arrays(config, lattice);
+    Simulator sim(config, lattice, base, cl);
+    if (rest_offsets_m) sim.set_rest_offsets(*rest_offsets_m);
+    const std::vector<double> at_rest(3 * lattice.element_count(), 0.0);
+    for (std::size_t k = 0; k < angles.size(); ++k) {
+      Scene posed = config;
+      posed.anchors[wall_index].rpy_deg += angles[k];
+      const ElementArrays el = make_element_arrays(posed, lattice);  // the held elements' new pose
+      sim.upload(turned_with_chest_wall(lattice, el, posed.anchors[wall_index]), at_rest);
+      sim.restart_clock();
+      const RunOutput run = run_simulation(posed, lattice, el, sim);
+      const PositioningMetrics m = compute_positioning_metrics(posed, lattice, el, run.summary, run.state);
+      require(m.tumour.has_value(), "the scene has no tumour tissue to follow", where,
+              "set [positioning] tumour_tissue to the tissue to follow");
+      PerturbedRun r;
+      r.index = int(k) + 1;
+      r.device = device;
+      r.rpy_deg = posed.anchors[wall_index].rpy_deg;
+      r.tumour_centroid_m = m.tumour->final_centroid_m;
+      r.converged = run.summary.converged;
+      r.steps = run.summary.steps;
+      (device ? with : without).push_back(r.tumour_centroid_m);
+      out.runs.push_back(r);
+      if (on_run) on_run(r);
+    }
+  }
+  if (!scene.tori.empty()) out.with_device = tumour_spread(with);
+  out.without_device = tumour_spread(without);
+  return out;
+}
+
+}  // namespace vb
