@@ -21,6 +21,7 @@ std::vector<double> press_curve_forces(const Scene& scene_in, const Lattice& lat
   require(tol > 0, "a force curve needs an equilibrium tolerance", "stop.equilibrium", "set it, e.g. 1e-7");
   const double F_ref = equilibrium_scales(lattice, elements).first;
   const std::int64_t check_every = std::max(1, scene.solver.check_every);
+  const std::int64_t max_steps = o.max_steps_per_level > 0 ? o.max_steps_per_level : scene.stop.max_steps;
 
   Simulator sim(scene, lattice, elements, cl);
   std::vector<double> forces;
@@ -43,11 +44,10 @@ std::vector<double> press_curve_forces(const Scene& scene_in, const Lattice& lat
         forces.push_back(-c.indenter_force_n[o.probe].dot(direction));
         break;
       }
-      require(sim.steps() - level_start < o.max_steps_per_level,
-              "no equilibrium at a travel of " + std::to_string(1e3 * d) + " mm after " +
-                  std::to_string(o.max_steps_per_level) + " steps (residual " +
-                  std::to_string(c.max_residual_n / F_ref) + ")",
-              "stop.equilibrium", "loosen the tolerance or check the anchors hold the model");
+      require(sim.steps() - level_start < max_steps,
+              "no equilibrium at a travel of " + std::to_string(1e3 * d) + " mm after " + std::to_string(max_steps) +
+                  " steps (residual " + std::to_string(c.max_residual_n / F_ref) + ")",
+              "stop.equilibrium", "loosen the tolerance, raise stop.max_steps, or check the anchors hold the model");
     }
     previous = d;
   }

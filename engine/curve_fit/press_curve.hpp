@@ -11,7 +11,7 @@ namespace vb {
 
 struct PressCurveOptions {
   std::size_t probe = 0;                    ///< the scene's indenter that presses
-  std::int64_t max_steps_per_level = 400000;  ///< more without equilibrium: vb::Error
+  std::int64_t max_steps_per_level = 0;  ///< more without equilibrium: vb::Error; 0: stop.max_steps
 };
 
 /// Forces (N) opposing the press at the given travels (m, ascending, ≥ 0) from the indenter's
