@@ -87,8 +87,9 @@ Command add_fit_curve(CLI::App& app) {
   sub->add_option("--params", o->params, "parameters: E, cubic, critical_strain, mu, alpha (default: the law's)")
       ->delimiter(',');
   sub->add_option("--points", o->points, "press levels compared, evenly over the travel (0: every measured one)")
-      ->check(CLI::NonNegativeNumber);
-  sub->add_option("--max-evaluations", o->max_evaluations, "press curves at most")->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  sub->add_option("--max-evaluations", o->max_evaluations, "press curves at most")
+      ->capture_default_str()->check(CLI::PositiveNumber);
   sub->add_option("--probe", o->probe, "which [[indenter]] presses (from 1)")->check(CLI::PositiveNumber);
   sub->add_option("--device,-d", o->device, "OpenCL device: gpu, cpu, an index or a name");
   sub->add_option("--precision", o->precision, "override solver.precision")->check(CLI::IsMember({"float", "double"}));

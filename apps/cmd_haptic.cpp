@@ -68,7 +68,7 @@ Command add_haptic(CLI::App& app) {
   sub->add_option("--trajectory,-t", o->trajectory, "CSV time_s,x_mm,y_mm,z_mm of the probe centre")
       ->required()->check(CLI::ExistingFile);
   sub->add_option("--out,-o", o->out, "output folder")->required();
-  sub->add_option("--rate-hz", o->rate_hz, "force outputs per second")->check(CLI::Range(1.0, 100000.0));
+  sub->add_option("--rate-hz", o->rate_hz, "force outputs per second")->capture_default_str()->check(CLI::Range(1.0, 100000.0));
   sub->add_option("--seconds", o->seconds, "run length (s; default: to the trajectory's end)")
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--probe", o->probe, "which [[indenter]] is the probe (from 1)")->check(CLI::PositiveNumber);
