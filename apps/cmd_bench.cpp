@@ -2,7 +2,8 @@
 // over the knobs users turn (law, integrator, precision, resolution, time step, volume
 // constraint), each measured against its scene's reference solution; plus steps/s of cube models
 // against the device's copy bandwidth (--sizes). Writes bench.json, bench.csv (and
-// throughput.csv). Design, reference and error measures: docs/BENCHMARKS.md.
+// throughput.csv); with --haptic the haptic rate of a probe pressing a block. Design, reference
+// and error measures: docs/BENCHMARKS.md.
 //   voxbreast bench --quick --out out/bench --phantom data-samples/phantom/scene.toml
 #include <chrono>
 #include <cmath>
@@ -18,6 +19,9 @@
 #include "engine/bench/bench_knobs.hpp"
 #include "engine/bench/bench_table.hpp"
 #include "engine/bench/standard_study.hpp"
+#include "engine/haptic/haptic_bench.hpp"
+#include "engine/haptic/haptic_report.hpp"
+#include "engine/lattice/voxelise.hpp"
 #include "io/atomic_file.hpp"
 #include "voxbreast/config.hpp"
 
@@ -28,8 +32,10 @@ const char* kDefaultPhantom = "data-samples/phantom/scene.toml";
 
 struct BenchOptions {
   std::string out, device, phantom;
-  bool quick = false, large = false, no_study = false, dry_run = false;
+  bool quick = false, large = false, no_study = false, dry_run = false, haptic = false;
   std::vector<int> sizes;  ///< throughput blocks (edge lengths in elements)
+  std::vector<int> haptic_elements = {10000};  ///< haptic-rate blocks (about this many elements)
+  double haptic_seconds = 3;
   std::vector<std::string> laws, integrators, scenes;
 };
 
@@ -75,6 +81,32 @@ nlohmann::json describe_scenes(const bench::StudyPlan& plan) {
   return scenes;
 }
 
+/// The haptic-rate section (docs/BENCHMARKS.md, "Haptic rate"): a probe pressing a block, force
+/// output at 1 kHz from a loop decoupled from the deformation updates.
+nlohmann::json run_haptic_bench(const ClContext& cl, const BenchOptions& o) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const int elements : o.haptic_elements) {
+    const Scene scene = haptic_bench_scene(std::size_t(elements), Precision::Float);
+    const Lattice lattice = build_lattice(voxelise_shapes(scene), 1);
+    const ElementArrays el = make_element_arrays(scene, lattice);
+    HapticProbe probe(scene, lattice, el, cl);
+    HapticLoopOptions loop;
+    loop.rate_hz = 1000;
+    loop.seconds = o.haptic_seconds;
+    const HapticLoopResult r = run_haptic_loop(probe, haptic_bench_press(scene, loop.seconds), loop);
+    nlohmann::json row = haptic_summary_json(r, loop, probe, lattice.element_count());
+    std::printf("haptic %7zu el: force %7.1f Hz (interval mean %.3f p99 %.3f max %.3f ms, %lld late%s); "
+                "%lld updates %.1f Hz, %.0f steps/s%s\n",
+                lattice.element_count(), r.achieved_rate_hz, 1e3 * r.intervals.mean_s, 1e3 * r.intervals.p99_s,
+                1e3 * r.intervals.max_s, (long long)r.intervals.missed, r.realtime ? ", real-time priority" : "",
+                (long long)r.updates, r.update_rate_hz, row["steps_per_second"].get<double>(),
+                r.blown_up ? "  BLEW UP" : "");
+    std::fflush(stdout);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
 int run_bench(BenchOptions o) {
   const auto start = std::chrono::steady_clock::now();
   ensure_output_dir(o.out);
@@ -98,7 +130,12 @@ int run_bench(BenchOptions o) {
   };
   std::unique_ptr<ClContext> cl;
   // The cubes first: they are short, and kept when a long study is cut off by a time limit.
-  if (!o.dry_run && (!o.sizes.empty() || (!o.quick && o.no_study))) {
+  if (!o.dry_run && o.haptic) {
+    if (!cl) cl = std::make_unique<ClContext>(device);
+    doc["haptic"] = run_haptic_bench(*cl, o);
+    write_outputs();
+  }
+  if (!o.dry_run && (!o.sizes.empty() || (!o.quick && o.no_study && !o.haptic))) {
     if (!cl) cl = std::make_unique<ClContext>(device);
     ThroughputOptions t;
     t.sizes = o.sizes.empty() ? std::vector<int>{33, 115} : o.sizes;  // 35,937 and 1,520,875 elements
@@ -175,6 +212,12 @@ Command add_bench(CLI::App& app) {
   sub->add_option("--sizes", o->sizes, "throughput: time cubes of these edge lengths in elements (e.g. 33 115)")
       ->check(CLI::Range(2, 1000));
   sub->add_flag("--dry-run", o->dry_run, "list the scenes and cases without running them");
+  sub->add_flag("--haptic", o->haptic, "haptic rate: a probe pressing a block, force output at 1 kHz (with "
+                                       "--no-study: only this)");
+  sub->add_option("--haptic-elements", o->haptic_elements, "haptic rate: blocks of about these element counts (default 10000)")
+      ->check(CLI::Range(64, 100000000));
+  sub->add_option("--haptic-seconds", o->haptic_seconds, "haptic rate: seconds per block (default 3)")
+      ->check(CLI::Range(0.1, 600.0));
   return {sub, [o] { return run_bench(*o); }};
 }
 

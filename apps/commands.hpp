@@ -16,5 +16,7 @@ Command add_simulate(CLI::App& app);
 Command add_bench(CLI::App& app);
 Command add_phantom(CLI::App& app);
 Command add_sweep(CLI::App& app);
+Command add_haptic(CLI::App& app);
+Command add_fit_curve(CLI::App& app);
 
 }  // namespace vb::app

@@ -90,6 +90,8 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
       real_size_(scene.solver.precision == Precision::Double ? sizeof(double) : sizeof(float)),
       inverse_mass_(el.inverse_mass) {
   require(n_ > 0, "the model has no elements", "model");
+  for (const IndenterSpec& ind : scene.indenters)
+    indenter_paths_.push_back({ind.start_m, ind.velocity_m_s, ind.travel_time_s});
   require(precision_ == Precision::Float || cl.info.fp64,
           "double precision requested but device '" + cl.info.name + "' has no fp64 support",
           "solver.precision", "use precision = \"float\" or another device");
@@ -492,8 +494,30 @@ void Simulator::set_lattice_args(cl::Kernel& k, int a) {
 }
 
 Vec3 Simulator::indenter_position(std::size_t i, double t) const {
-  const IndenterSpec& ind = scene_.indenters.at(i);
-  return ind.start_m + ind.velocity_m_s * std::min(t, ind.travel_time_s);
+  const IndenterPath& path = indenter_paths_.at(i);
+  return path.start_m + path.velocity_m_s * std::min(t, path.travel_time_s);
+}
+
+void Simulator::set_indenter_path(std::size_t i, const Vec3& from_m, const Vec3& to_m, double t0_s, double t1_s) {
+  require(i < indenter_paths_.size(), "indenter " + std::to_string(i + 1) + " does not exist", "indenter");
+  IndenterPath& path = indenter_paths_[i];
+  if (t1_s > t0_s) {
+    path.velocity_m_s = (to_m - from_m) / (t1_s - t0_s);
+    path.start_m = from_m - path.velocity_m_s * t0_s;  // so that start + velocity·t0 = from
+    path.travel_time_s = t1_s;
+  } else {
+    path = {to_m, Vec3::Zero(), 0.0};
+  }
+  const std::vector<double> table = obstacle_table();
+  const std::size_t first = kIndenterStride * i;
+  if (precision_ == Precision::Double) {
+    cl_.queue.enqueueWriteBuffer(indenters_, CL_TRUE, first * sizeof(double), kIndenterStride * sizeof(double),
+                                 &table[first]);
+  } else {
+    std::vector<float> row(kIndenterStride);
+    for (int k = 0; k < kIndenterStride; ++k) row[k] = float(std::clamp(table[first + k], -3e38, 3e38));
+    cl_.queue.enqueueWriteBuffer(indenters_, CL_TRUE, first * sizeof(float), row.size() * sizeof(float), row.data());
+  }
 }
 
 std::size_t Simulator::torus_table_base() const {
@@ -506,11 +530,12 @@ std::vector<double> Simulator::obstacle_table() const {
   const Eigen::Matrix3d Rt = lattice_.rotation.transpose();
   for (std::size_t i = 0; i < scene_.indenters.size(); ++i) {
     const IndenterSpec& ind = scene_.indenters[i];
+    const IndenterPath& path = indenter_paths_[i];
     double* row = &table[kIndenterStride * i];
-    const Vec3 start = Rt * ind.start_m, normal = Rt * ind.normal, velocity = Rt * ind.velocity_m_s;
+    const Vec3 start = Rt * path.start_m, normal = Rt * ind.normal, velocity = Rt * path.velocity_m_s;
     for (int c = 0; c < 3; ++c) row[c] = start[c], row[4 + c] = normal[c], row[8 + c] = velocity[c];
     row[3] = ind.kind == IndenterSpec::Kind::Plate ? -1.0 : ind.radius_m;
-    row[12] = std::isfinite(ind.travel_time_s) ? ind.travel_time_s : 1e300;
+    row[12] = std::isfinite(path.travel_time_s) ? path.travel_time_s : 1e300;
     row[13] = double(int(ind.contact));  // 0 push, 1 slide, 2 stick
   }
   // Torus rows (kernels/device_contact.cl), then each torus's knots: time, minor and major

@@ -94,6 +94,11 @@ class Simulator {
   Precision precision() const { return precision_; }
   /// position of indenter i at simulated time t (m)
   Vec3 indenter_position(std::size_t i, double t_s) const;
+  /// Replaces indenter i's path: from `from_m` at simulated time t0 it moves straight to `to_m`,
+  /// reached at t1 (> t0; t1 ≤ t0 jumps there), and holds (world frame, m). Rewrites only the
+  /// start, velocity and travel time of its row; for probes driven from outside the scene
+  /// (engine/haptic, force curves). Waits for the device queue.
+  void set_indenter_path(std::size_t i, const Vec3& from_m, const Vec3& to_m, double t0_s, double t1_s);
   /// [[device.torus]] only: each element's surface-area share (m², rest; 0 off the surface) that
   /// contact pressures divide by
   const std::vector<double>& contact_area_m2() const { return contact_area_host_; }
@@ -126,8 +131,15 @@ class Simulator {
   /// read-only buffer of reals in the run's precision
   cl::Buffer make_real_buffer(const std::vector<double>& values) const;
 
+  /// One indenter's straight path: position start + velocity·min(t, travel_time) (world, m)
+  struct IndenterPath {
+    Vec3 start_m, velocity_m_s;
+    double travel_time_s;
+  };
+
   const Scene& scene_;
   const Lattice& lattice_;
+  std::vector<IndenterPath> indenter_paths_;  ///< the scene's paths, or set_indenter_path's
   const ClContext& cl_;
   Precision precision_;
   std::size_t n_;

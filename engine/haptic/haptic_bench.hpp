@@ -1,0 +1,14 @@
+#pragma once
+/// The haptic-rate benchmark model (docs/BENCHMARKS.md, "Haptic rate"): a block of soft tissue
+/// (E = 3 kPa) on a held base, about `elements` elements at 2 mm spacing, with a 5 mm sphere
+/// probe above the centre of its top face, relaxed quasi-statically; and a press: down 8 mm in
+/// the first third of the run, held, back up in the last third.
+#include "engine/haptic/haptic_loop.hpp"
+#include "engine/scene/scene.hpp"
+
+namespace vb {
+
+Scene haptic_bench_scene(std::size_t elements, Precision precision);
+ProbeTrajectory haptic_bench_press(const Scene& scene, double seconds);
+
+}  // namespace vb
