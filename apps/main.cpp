@@ -5,6 +5,7 @@
 //   voxbreast simulate data-samples/breast_phantom.toml --out out/phantom
 //   voxbreast sweep data-samples/phantom/scene.toml --vary gravity.posture=prone,supine --out out/sweep
 //   voxbreast bench --quick --out out/bench
+//   voxbreast probe data-samples/palpation/scene.toml --out out/palpation
 // Every subcommand has --help. Errors print one line naming the problem and exit non-zero.
 #include <CL/opencl.hpp>
 #include <cstdio>
@@ -20,7 +21,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   const vb::app::Command commands[] = {vb::app::add_info(app), vb::app::add_simulate(app),
                                        vb::app::add_bench(app), vb::app::add_phantom(app),
-                                       vb::app::add_sweep(app)};
+                                       vb::app::add_sweep(app), vb::app::add_probe(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
