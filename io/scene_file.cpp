@@ -669,6 +669,7 @@ const NameTable<IndenterSpec::Contact> kContacts = {
 
 IndenterSpec read_indenter(const Section& s, const std::string& scene_dir) {
   IndenterSpec i;
+  i.has_start = false;
   i.line = s.line();
   i.kind = s.kind(kIndenterKinds).value;
   if (i.kind != IndenterSpec::Kind::Plate) i.radius_m = s.required("radius", s.positive("radius"));
@@ -691,7 +692,8 @@ IndenterSpec read_indenter(const Section& s, const std::string& scene_dir) {
     i.start_m = i.path.front().position_m;
     return i;
   }
-  i.start_m = s.required("start", s.vec3("start"));
+  // [probe] places its indenter itself; every other indenter needs a start (checked once [probe] is read)
+  if (const auto start = s.vec3("start")) i.start_m = *start, i.has_start = true;
   i.velocity_m_s = s.vec3("velocity").value_or(i.velocity_m_s);
   i.travel_time_s = s.positive("travel_time").value_or(i.travel_time_s);
   return i;
@@ -969,6 +971,10 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
   scene.output = read_output(top.table_or_empty("output"), scene.model);
   if (const auto volume = top.table("volume")) scene.volume = read_volume(*volume);
   if (const auto probe = top.table("probe")) scene.probe = read_probe(*probe, scene.indenters);
+  for (std::size_t i = 0; i < scene.indenters.size(); ++i)
+    if (!scene.indenters[i].has_start && scene.indenters[i].path.empty() && !(scene.probe.active && scene.probe.indenter == i))
+      throw Error("missing required key", where_string(source_name, scene.indenters[i].line, "indenter[" + std::to_string(i) + "].start"),
+                  "only the [probe] indenter may leave out 'start'");
   check_labels(scene, source_name);
   scene.source_text = text;
   return scene;

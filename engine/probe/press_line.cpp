@@ -55,10 +55,11 @@ std::vector<double> positions(const Lattice& lattice, const std::vector<double>&
   return x;
 }
 
-/// Travel along `dir` from `from` at which the indenter first touches an element at x (m): the
-/// signed distance of the nearest element falls with travel, so bisection finds its zero.
+/// Travel along `dir` from `from` at which the indenter first touches an element at x (m): scanned
+/// in steps of `step` (shorter than the indenter and the spacing, so no element is stepped over),
+/// then bisected in the step where the nearest element's signed distance first drops to zero.
 double first_touch(const IndenterSpec& ind, const Vec3& from, const Vec3& dir, const std::vector<double>& x,
-                   double reach) {
+                   double reach, double step) {
   const auto gap = [&](double s) {
     double g = INFINITY;
     for (std::size_t e = 0; e < x.size() / 3; ++e)
@@ -66,10 +67,13 @@ double first_touch(const IndenterSpec& ind, const Vec3& from, const Vec3& dir, c
     return g;
   };
   if (gap(0) <= 0) return 0;
-  if (gap(reach) > 0) return NAN;
-  double lo = 0, hi = reach;
-  for (int k = 0; k < 60 && hi - lo > 1e-9; ++k) (gap(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);
-  return hi;
+  for (double lo = 0; lo < reach; lo += step) {
+    double hi = lo + step;
+    if (gap(hi) > 0) continue;
+    for (int k = 0; k < 60 && hi - lo > 1e-9; ++k) (gap(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);
+    return hi;
+  }
+  return NAN;
 }
 
 }  // namespace
@@ -115,7 +119,8 @@ ProbeResult run_press_line(const Scene& scene, const Lattice& lattice, const Ele
       double reach = 0;  // the indenter touches every element before its reference point travels this far
       for (std::size_t e = 0; e < x0.size() / 3; ++e)
         reach = std::max(reach, (Vec3(x0[3 * e], x0[3 * e + 1], x0[3 * e + 2]) - start).norm());
-      const double touch = first_touch(ind, start, dir, x0, reach);
+      const double step = 0.5 * (ind.kind == IndenterSpec::Kind::Plate ? h : std::min(h, ind.radius_m));
+      const double touch = first_touch(ind, start, dir, x0, reach, step);
       require(std::isfinite(touch), "press " + std::to_string(k + 1) + " never touches the model", "probe.from",
               "start the presses beside the model and point 'direction' at it");
       start += touch * dir;

@@ -133,6 +133,7 @@ struct IndenterSpec {
   double travel_time_s = std::numeric_limits<double>::infinity();  ///< stops moving after this
   std::vector<PathKnot> path;        ///< recorded trajectory (replaces start/velocity); empty: none
   std::string path_file;             ///< the trajectory's CSV (for messages), empty if none
+  bool has_start = true;             ///< false: the scene file gave none (the [probe] indenter may omit it)
   int line = 0;
 };
 
