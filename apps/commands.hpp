@@ -18,5 +18,6 @@ Command add_phantom(CLI::App& app);
 Command add_sweep(CLI::App& app);
 Command add_haptic(CLI::App& app);
 Command add_fit_curve(CLI::App& app);
+Command add_probe(CLI::App& app);
 
 }  // namespace vb::app

@@ -6,6 +6,7 @@
 //   voxbreast sweep data-samples/phantom/scene.toml --vary gravity.posture=prone,supine --out out/sweep
 //   voxbreast bench --quick --out out/bench
 //   voxbreast haptic scene.toml --trajectory press.csv --rate-hz 1000 --out out/haptic
+//   voxbreast probe data-samples/palpation/scene.toml --out out/palpation
 // Every subcommand has --help. Errors print one line naming the problem and exit non-zero.
 #include <CL/opencl.hpp>
 #include <cstdio>
@@ -22,7 +23,7 @@ int main(int argc, char** argv) {
   const vb::app::Command commands[] = {vb::app::add_info(app), vb::app::add_simulate(app),
                                        vb::app::add_bench(app), vb::app::add_phantom(app),
                                        vb::app::add_sweep(app), vb::app::add_haptic(app),
-                                       vb::app::add_fit_curve(app)};
+                                       vb::app::add_fit_curve(app), vb::app::add_probe(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "apps/device_mesh_outputs.hpp"
+#include "engine/error.hpp"
 #include "apps/image_outputs.hpp"
 #include "apps/mesh_outputs.hpp"
 #include "io/atomic_file.hpp"
@@ -41,6 +42,10 @@ void write_reproducibility_csv(const std::string& path, const ReproducibilityRes
 
 SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const std::string& out_dir,
                                 const SimulationOptions& options) {
+  // The [probe] indenter may have no start: only voxbreast probe places it.
+  require(!scene.probe.active || scene.indenters[scene.probe.indenter].has_start,
+          "the [probe] indenter has no start, so only 'voxbreast probe' can run this scene", "probe.indenter",
+          "run voxbreast probe, or give the indenter a start");
   std::unique_lock io(file_io_mutex());
   const PreparedModel model = prepare_model(scene);
   io.unlock();

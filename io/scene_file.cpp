@@ -22,6 +22,7 @@
 #include "engine/material/hyperelastic.hpp"
 #include "engine/loads/posture.hpp"
 #include "io/did_you_mean.hpp"
+#include "io/indenter_path_csv.hpp"
 
 namespace vb {
 namespace {
@@ -652,8 +653,12 @@ AnchorSpec read_anchor(const std::string& name, const Section& s) {
 }
 
 const NameTable<IndenterSpec::Kind> kIndenterKinds = {
-    {"sphere", IndenterSpec::Kind::Sphere, {"kind", "radius", "start", "velocity", "travel_time", "contact"}},
-    {"plate", IndenterSpec::Kind::Plate, {"kind", "start", "normal", "velocity", "travel_time", "contact"}},
+    {"sphere", IndenterSpec::Kind::Sphere, {"kind", "radius", "start", "velocity", "travel_time", "path", "contact"}},
+    {"plate", IndenterSpec::Kind::Plate, {"kind", "start", "normal", "velocity", "travel_time", "path", "contact"}},
+    {"cylinder", IndenterSpec::Kind::Cylinder,
+     {"kind", "radius", "axis", "start", "velocity", "travel_time", "path", "contact"}},
+    {"capsule", IndenterSpec::Kind::Capsule,
+     {"kind", "radius", "axis", "length", "start", "velocity", "travel_time", "path", "contact"}},
 };
 
 const NameTable<IndenterSpec::Contact> kContacts = {
@@ -662,16 +667,35 @@ const NameTable<IndenterSpec::Contact> kContacts = {
     {"stick", IndenterSpec::Contact::Stick, {}},
 };
 
-IndenterSpec read_indenter(const Section& s) {
+IndenterSpec read_indenter(const Section& s, const std::string& scene_dir) {
   IndenterSpec i;
+  i.has_start = false;
   i.line = s.line();
   i.kind = s.kind(kIndenterKinds).value;
-  if (i.kind == IndenterSpec::Kind::Sphere) i.radius_m = s.required("radius", s.positive("radius"));
+  if (i.kind != IndenterSpec::Kind::Plate) i.radius_m = s.required("radius", s.positive("radius"));
   if (i.kind == IndenterSpec::Kind::Plate) i.normal = s.required("normal", s.direction("normal"));
-  i.start_m = s.required("start", s.vec3("start"));
+  if (i.kind == IndenterSpec::Kind::Cylinder || i.kind == IndenterSpec::Kind::Capsule)
+    i.normal = s.required("axis", s.direction("axis"));
+  if (i.kind == IndenterSpec::Kind::Capsule) i.length_m = s.required("length", s.positive("length"));
+  if (const auto* n = s.named("contact", kContacts)) i.contact = n->value;
+  if (const auto path = s.text("path")) {
+    for (const char* key : {"start", "velocity", "travel_time"})
+      if (s.find(key)) s.fail(key, "a trajectory ('path') gives the positions already", "remove '" + std::string(key) + "'");
+    std::filesystem::path file(*path);
+    if (file.is_relative()) file = std::filesystem::path(scene_dir) / file;
+    i.path_file = file.lexically_normal().string();
+    try {
+      i.path = read_indenter_path_csv(i.path_file);
+    } catch (const Error& e) {
+      s.fail("path", e.what());
+    }
+    i.start_m = i.path.front().position_m;
+    return i;
+  }
+  // [probe] places its indenter itself; every other indenter needs a start (checked once [probe] is read)
+  if (const auto start = s.vec3("start")) i.start_m = *start, i.has_start = true;
   i.velocity_m_s = s.vec3("velocity").value_or(i.velocity_m_s);
   i.travel_time_s = s.positive("travel_time").value_or(i.travel_time_s);
-  if (const auto* n = s.named("contact", kContacts)) i.contact = n->value;
   return i;
 }
 
@@ -808,6 +832,43 @@ std::vector<TrackSpec> read_tracks(const std::vector<Section>& sections) {
   return tracks;
 }
 
+/// [probe] (docs/SCENE.md): a line of quasi-static presses with one of the indenters.
+ProbeSpec read_probe(const Section& s, const std::vector<IndenterSpec>& indenters) {
+  s.check_keys({"indenter", "from", "to", "presses", "direction", "depth", "steps", "from_contact", "at_force"});
+  ProbeSpec p;
+  p.active = true;
+  p.line = s.line();
+  const int which = s.integer<int>("indenter", 1).value_or(1);
+  if (std::size_t(which) > indenters.size())
+    s.fail("indenter", "names indenter " + std::to_string(which) + " but the scene has " +
+                           std::to_string(indenters.size()) + " [[indenter]] tables",
+           "indenters count from 1 in file order");
+  p.indenter = std::size_t(which - 1);
+  if (indenters[p.indenter].kind == IndenterSpec::Kind::Plate)
+    s.fail("indenter", "a plate cannot probe a line of points", "use a sphere, cylinder or capsule indenter");
+  if (!indenters[p.indenter].path.empty())
+    s.fail("indenter", "the probing indenter has a recorded trajectory ('path')", "[probe] moves it itself: remove the path");
+  p.from_m = s.required("from", s.vec3("from"));
+  p.to_m = s.vec3("to").value_or(p.from_m);
+  p.presses = s.integer<int>("presses", 1).value_or(p.presses);
+  if (p.presses == 1 && s.find("to") && (p.to_m - p.from_m).norm() > 0)
+    s.fail("presses", "one press with a 'to' point", "give presses ≥ 2 for a line, or leave out 'to'");
+  p.direction = s.direction("direction").value_or(p.direction);
+  p.depth_m = s.required("depth", s.positive("depth"));
+  p.steps = s.integer<int>("steps", 1).value_or(p.steps);
+  p.from_contact = s.boolean("from_contact").value_or(p.from_contact);
+  if (const toml::node* node = s.find("at_force")) {
+    const toml::array* array = node->as_array();
+    if (!array) s.fail("at_force", "expected an array of forces (N)");
+    for (const toml::node& n : *array) {
+      const std::optional<double> x = as_double(n);
+      if (!x || !(*x > 0)) s.fail("at_force", "forces must be positive numbers (N)");
+      p.at_force_n.push_back(*x);
+    }
+  }
+  return p;
+}
+
 StopSpec read_stop(const Section& s) {
   s.check_keys({"equilibrium", "max_steps", "time"});
   StopSpec stop;
@@ -931,7 +992,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
   const Section top(root, "", source_name);
   top.check_keys(
       {"model", "materials", "solver", "gravity", "anchor", "indenter", "device", "positioning", "track", "stop",
-       "output", "volume", "reference_state", "reproducibility"});
+       "output", "volume", "reference_state", "reproducibility", "probe"});
   Scene scene;
   scene.model = read_model(top.table_or_empty("model"));
   scene.materials = read_materials(top.table_or_empty("materials"));
@@ -940,7 +1001,8 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
   for (const auto& [name, s] : top.table_or_empty("anchor").named_tables()) {
     scene.anchors.push_back(read_anchor(name, s));
   }
-  for (const Section& s : top.tables("indenter")) scene.indenters.push_back(read_indenter(s));
+  const std::string scene_dir = std::filesystem::path(source_name).parent_path().string();
+  for (const Section& s : top.tables("indenter")) scene.indenters.push_back(read_indenter(s, scene_dir));
   if (const auto device = top.table("device")) scene.tori = read_device(*device);
   if (const auto positioning = top.table("positioning")) scene.positioning = read_positioning(*positioning, scene.anchors);
   scene.tracks = read_tracks(top.tables("track"));
@@ -951,6 +1013,11 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
   if (const auto r = top.table("reproducibility")) scene.reproducibility = read_reproducibility(*r, scene.anchors);
   if (scene.reference_state.active && !scene.gravity.active)
     top.fail("reference_state", "[reference_state] needs a [gravity] section: the posture the run goes to");
+  if (const auto probe = top.table("probe")) scene.probe = read_probe(*probe, scene.indenters);
+  for (std::size_t i = 0; i < scene.indenters.size(); ++i)
+    if (!scene.indenters[i].has_start && scene.indenters[i].path.empty() && !(scene.probe.active && scene.probe.indenter == i))
+      throw Error("missing required key", where_string(source_name, scene.indenters[i].line, "indenter[" + std::to_string(i) + "].start"),
+                  "only the [probe] indenter may leave out 'start'");
   check_labels(scene, source_name);
   scene.source_text = text;
   return scene;

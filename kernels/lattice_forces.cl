@@ -117,25 +117,56 @@ inline real4 static_force(uint e, real4 ui, real4 vi, global const real4* u, glo
 }
 
 #if VB_INDENTERS
+// Row columns (kernels/common.cl, VB_IND_STRIDE): the path is start + velocity·clamp(t − t0, 0,
+// travel), so the host can move an indenter between steps by rewriting one row (a recorded
+// trajectory, quasi-static presses) without touching the kernels.
 inline real4 indenter_position(global const real* ind, real t) {
-  const real tt = fmin(t, ind[12]);
+  const real tt = clamp(t - ind[16], (real)0, ind[12]);
   return (real4)(ind[0] + ind[8] * tt, ind[1] + ind[9] * tt, ind[2] + ind[10] * tt, 0);
 }
 
 inline real4 indenter_velocity(global const real* ind, real t) {
-  return t < ind[12] ? (real4)(ind[8], ind[9], ind[10], 0) : (real4)(0);
+  const real tt = t - ind[16];
+  return tt >= 0 && tt < ind[12] ? (real4)(ind[8], ind[9], ind[10], 0) : (real4)(0);
 }
 
 // Signed distance from the indenter surface at time t (m, < 0 inside) and the outward normal.
+// Kinds (column 14): 0 sphere (centre, radius), 1 plate (point, normal into the tissue),
+// 2 flat-ended cylinder (centre of the flat end, axis = press direction, radius; the body extends
+// backwards from the end face), 3 capsule (segment from the start along the axis over column 15's
+// length, radius): a finger.
 inline real indenter_distance(real4 x, global const real* ind, real t, real4* n_out) {
   const real4 p = indenter_position(ind, t);
-  if (ind[3] < 0) {  // plate
-    *n_out = (real4)(ind[4], ind[5], ind[6], 0);
-    return dot3(x - p, *n_out);
-  }
+  const int kind = (int)ind[14];
   const real4 d = xyz0(x - p);
-  const real dist = length(d);
-  *n_out = dist > 0 ? d / dist : (real4)(0, 0, 1, 0);
+  const real4 a = (real4)(ind[4], ind[5], ind[6], 0);
+  if (kind == 1) {
+    *n_out = a;
+    return dot3(d, a);
+  }
+  if (kind == 2) {
+    const real s = dot3(d, a);  // > 0: ahead of the end face
+    const real4 radial = d - s * a;
+    const real r = length(radial);
+    const real4 er = r > 0 ? radial / r : (real4)(0);
+    const real out = r - ind[3];  // > 0: beside the side wall
+    if (s > 0 && out > 0) {       // off the rim: nearest point is on the edge circle
+      const real dist = sqrt(s * s + out * out);
+      *n_out = (s * a + out * er) / dist;
+      return dist;
+    }
+    if (s > 0 || (out <= 0 && s >= out)) {  // in front of the face, or inside and nearer the face
+      *n_out = a;
+      return s;
+    }
+    *n_out = er;  // beside the wall, or inside and nearer the wall
+    return out;
+  }
+  real4 c = p;
+  if (kind == 3) c = p + clamp(dot3(d, a), (real)0, ind[15]) * a;  // nearest point of the segment
+  const real4 dc = xyz0(x - c);
+  const real dist = length(dc);
+  *n_out = dist > 0 ? dc / dist : (real4)(0, 0, 1, 0);
   return dist - ind[3];
 }
 

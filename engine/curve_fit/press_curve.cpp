@@ -31,8 +31,9 @@ std::vector<double> press_curve_forces(const Scene& scene_in, const Lattice& lat
     // At most a hundredth of a spacing per step: contact stays a gentle push.
     const std::int64_t ramp = std::max<std::int64_t>(1, std::int64_t(std::ceil((d - previous) / (0.01 * h))));
     const double t0 = sim.time_s();
-    sim.set_indenter_path(o.probe, ind.start_m + previous * direction, ind.start_m + d * direction, t0,
-                          t0 + double(ramp) * sim.dt_s());
+    sim.set_indenter_motion(o.probe, IndenterMotion::straight(ind.start_m + previous * direction,
+                                                              ind.start_m + d * direction, t0,
+                                                              t0 + double(ramp) * sim.dt_s()));
     const std::int64_t level_start = sim.steps();
     for (;;) {
       sim.advance(check_every);

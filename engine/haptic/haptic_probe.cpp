@@ -31,7 +31,7 @@ HapticProbe::HapticProbe(const Scene& scene, const Lattice& lattice, const Eleme
   max_stiffness_n_m_ = 10 * (F_ref_ / (spacing_m_ * spacing_m_)) * (probe.radius_m + spacing_m_);
   steps_per_update_ = options.steps_per_update > 0 ? options.steps_per_update : std::max(1, scene.solver.check_every);
   commanded_m_ = probe.start_m;
-  sim_.set_indenter_path(options.probe, probe.start_m, probe.start_m, 0, 0);
+  sim_.place_indenter(options.probe, probe.start_m);
   last_.probe_m = secant_from_m_ = probe.start_m;
 }
 
@@ -100,7 +100,8 @@ bool HapticProbe::update() {
   Vec3 to = target;
   if ((to - from).norm() > max_move) to = from + (to - from).normalized() * max_move;
   const double t0 = sim_.time_s();
-  sim_.set_indenter_path(options_.probe, from, to, t0, t0 + double(steps_per_update_) * sim_.dt_s());
+  sim_.set_indenter_motion(options_.probe,
+                           IndenterMotion::straight(from, to, t0, t0 + double(steps_per_update_) * sim_.dt_s()));
   sim_.advance(steps_per_update_);
   const StateCheck c = sim_.check();
 

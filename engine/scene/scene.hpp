@@ -104,19 +104,56 @@ struct AnchorSpec {
   int line = 0;
 };
 
-/// Rigid indenter moved at constant velocity. By default it pushes (frictionless) the elements it
-/// touches; it can also hold them on its surface (slide: bonded along the normal, free along the
-/// surface; stick: moving with it), which gives tension and shear tests.
+/// One knot of a recorded indenter trajectory: the indenter's reference point at a time; between
+/// knots it moves linearly, before the first and after the last it holds.
+struct PathKnot {
+  double time_s = 0;
+  Vec3 position_m = Vec3::Zero();
+};
+
+/// Rigid indenter moved at constant velocity, or along a recorded trajectory. By default it pushes
+/// (frictionless) the elements it touches; it can also hold them on its surface (slide: bonded
+/// along the normal, free along the surface; stick: moving with it), which gives tension and
+/// shear tests. Shapes (docs/SCENE.md, [[indenter]]): a sphere, a plate, a flat-ended cylinder
+/// (punch) and a capsule (finger).
 struct IndenterSpec {
-  enum class Kind { Sphere, Plate };
+  enum class Kind { Sphere, Plate, Cylinder, Capsule };
   enum class Contact { Push, Slide, Stick };
   Kind kind = Kind::Sphere;
   Contact contact = Contact::Push;
-  double radius_m = 0;               ///< sphere radius (m)
-  Vec3 start_m = Vec3::Zero();       ///< sphere centre / a point on the plate at t = 0 (m)
-  Vec3 normal = Vec3::UnitZ();       ///< plate: unit normal pointing from the plate into the tissue
+  double radius_m = 0;               ///< sphere, cylinder, capsule radius (m)
+  double length_m = 0;               ///< capsule: length of its axis segment (m)
+  /// sphere centre / a point on the plate / centre of the cylinder's flat end / the capsule's tip
+  /// centre (the segment's first end) at t = 0 (m)
+  Vec3 start_m = Vec3::Zero();
+  /// plate: unit normal from the plate into the tissue; cylinder: unit axis from the body
+  /// through its flat end (the press direction); capsule: unit direction from the tip along the segment
+  Vec3 normal = Vec3::UnitZ();
   Vec3 velocity_m_s = Vec3::Zero();  ///< (m/s)
   double travel_time_s = std::numeric_limits<double>::infinity();  ///< stops moving after this
+  std::vector<PathKnot> path;        ///< recorded trajectory (replaces start/velocity); empty: none
+  std::string path_file;             ///< the trajectory's CSV (for messages), empty if none
+  bool has_start = true;             ///< false: the scene file gave none (the [probe] indenter may omit it)
+  int line = 0;
+};
+
+/// A line of quasi-static presses ([probe], docs/SCENE.md, docs/PROBING.md): the model first
+/// settles (gravity equilibrium), then each press starts from that settled state, moves the
+/// indenter in `steps` equal increments to `depth` along `direction`, reaches equilibrium at each
+/// and records the reaction force; the presses are spread evenly from `from` to `to`.
+struct ProbeSpec {
+  bool active = false;
+  std::size_t indenter = 0;          ///< which [[indenter]] presses (0-based; the scene key is 1-based)
+  Vec3 from_m = Vec3::Zero();        ///< the indenter's reference point for the first press (m)
+  Vec3 to_m = Vec3::Zero();          ///< ... and for the last (m)
+  int presses = 1;
+  Vec3 direction = -Vec3::UnitZ();   ///< unit press direction
+  double depth_m = 0;                ///< press depth beyond the zero point (m)
+  int steps = 10;                    ///< quasi-static increments per press
+  /// zero point of each press: where the indenter first touches the settled surface when moved
+  /// from `from`…`to` along `direction` (true), or the given point itself (false)
+  bool from_contact = true;
+  std::vector<double> at_force_n;    ///< report the press depth at these forces (N)
   int line = 0;
 };
 
@@ -217,6 +254,7 @@ struct Scene {
   VolumeSpec volume;
   ReferenceStateSpec reference_state;
   ReproducibilitySpec reproducibility;
+  ProbeSpec probe;  ///< [probe]: voxbreast probe runs a line of presses
   std::string source_path;  ///< file the scene came from (for messages)
   std::string source_text;  ///< the scene file text, stored with results
 };

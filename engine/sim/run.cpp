@@ -130,8 +130,10 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
   const double extent = h * Eigen::Vector3d(lattice.dims[0], lattice.dims[1], lattice.dims[2]).norm();
   const double tol = scene.stop.equilibrium;
   double travel_end = 0;  // equilibrium only counts once every moving indenter has stopped
-  for (const IndenterSpec& ind : scene.indenters)
+  for (const IndenterSpec& ind : scene.indenters) {
     if (ind.velocity_m_s.squaredNorm() > 0) travel_end = std::max(travel_end, ind.travel_time_s);
+    if (!ind.path.empty()) travel_end = std::max(travel_end, ind.path.back().time_s);
+  }
   for (const TorusSpec& t : scene.tori) travel_end = std::max(travel_end, torus_inflation_end_s(t));
   const std::int64_t check_every = std::max(1, scene.solver.check_every);
   const std::int64_t frames_every = scene.output.frames_every;
@@ -172,7 +174,7 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
       ir.position_m = sim.indenter_position(i, sim.time_s());
       ir.reaction_force_n = c.indenter_force_n[i];
       ir.contact_elements = c.contact_elements[i];
-      const double travel = (ir.position_m - scene.indenters[i].start_m).norm();
+      const double travel = (ir.position_m - sim.indenter_position(i, 0)).norm();
       const Vec3& f = ir.reaction_force_n;
       ir.history.push_back({sim.time_s(), f.x(), f.y(), f.z(), travel});
     }

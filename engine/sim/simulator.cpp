@@ -16,7 +16,7 @@ namespace {
 constexpr int kCheckWorkGroup = 128;
 constexpr int kCheckBaseSlots = 5, kCheckSlotsPerIndenter = 4;  // kernels/checks.cl
 constexpr int kCheckSlotsPerTorus = 8;                             // VB_TORUS_SLOTS
-constexpr int kIndenterStride = 16;                                // VB_IND_STRIDE
+constexpr int kIndenterStride = 20;                                // VB_IND_STRIDE
 constexpr int kTorusStride = 12;                                   // VB_TORUS_STRIDE
 // Kernel argument layout (kernels/common.cl): VB_LATTICE_PARAMS then VB_INDENTER_PARAMS.
 constexpr int kLatticeArgs = 16, kIndenterArgs = 3;
@@ -90,8 +90,6 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
       real_size_(scene.solver.precision == Precision::Double ? sizeof(double) : sizeof(float)),
       inverse_mass_(el.inverse_mass) {
   require(n_ > 0, "the model has no elements", "model");
-  for (const IndenterSpec& ind : scene.indenters)
-    indenter_paths_.push_back({ind.start_m, ind.velocity_m_s, ind.travel_time_s});
   require(precision_ == Precision::Float || cl.info.fp64,
           "double precision requested but device '" + cl.info.name + "' has no fp64 support",
           "solver.precision", "use precision = \"float\" or another device");
@@ -175,6 +173,11 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
               std::to_string(local_bytes) + " bytes)",
           "indenter, device.torus", "use fewer indenters or tori, or float precision");
   partial_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * check_slots_ * real_size_);
+  for (const IndenterSpec& ind : scene.indenters) {
+    motion_.push_back({ind.start_m, ind.velocity_m_s, 0.0, ind.travel_time_s});
+    if (!ind.path.empty()) motion_.back() = {ind.path.front().position_m, Vec3::Zero(), 0.0, 0.0};
+  }
+  path_segment_.assign(scene.indenters.size(), std::size_t(-1));
   indenters_ = make_real_buffer(obstacle_table());
   partial_arg_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * sizeof(cl_int));
 
@@ -494,29 +497,58 @@ void Simulator::set_lattice_args(cl::Kernel& k, int a) {
 }
 
 Vec3 Simulator::indenter_position(std::size_t i, double t) const {
-  const IndenterPath& path = indenter_paths_.at(i);
-  return path.start_m + path.velocity_m_s * std::min(t, path.travel_time_s);
+  const std::vector<PathKnot>& path = scene_.indenters.at(i).path;
+  if (path.empty()) return motion_.at(i).position_m(t);
+  if (t <= path.front().time_s) return path.front().position_m;
+  for (std::size_t k = 0; k + 1 < path.size(); ++k)
+    if (t < path[k + 1].time_s) {
+      const double f = (t - path[k].time_s) / (path[k + 1].time_s - path[k].time_s);
+      return path[k].position_m + f * (path[k + 1].position_m - path[k].position_m);
+    }
+  return path.back().position_m;
 }
 
-void Simulator::set_indenter_path(std::size_t i, const Vec3& from_m, const Vec3& to_m, double t0_s, double t1_s) {
-  require(i < indenter_paths_.size(), "indenter " + std::to_string(i + 1) + " does not exist", "indenter");
-  IndenterPath& path = indenter_paths_[i];
-  if (t1_s > t0_s) {
-    path.velocity_m_s = (to_m - from_m) / (t1_s - t0_s);
-    path.start_m = from_m - path.velocity_m_s * t0_s;  // so that start + velocity·t0 = from
-    path.travel_time_s = t1_s;
-  } else {
-    path = {to_m, Vec3::Zero(), 0.0};
-  }
-  const std::vector<double> table = obstacle_table();
-  const std::size_t first = kIndenterStride * i;
+std::vector<double> Simulator::indenter_row(std::size_t i) const {
+  const IndenterSpec& ind = scene_.indenters[i];
+  const IndenterMotion& m = motion_[i];
+  const Eigen::Matrix3d Rt = lattice_.rotation.transpose();
+  std::vector<double> row(kIndenterStride, 0.0);
+  const Vec3 start = Rt * m.start_m, normal = Rt * ind.normal, velocity = Rt * m.velocity_m_s;
+  for (int c = 0; c < 3; ++c) row[c] = start[c], row[4 + c] = normal[c], row[8 + c] = velocity[c];
+  row[3] = ind.kind == IndenterSpec::Kind::Plate ? -1.0 : ind.radius_m;
+  row[12] = std::isfinite(m.travel_time_s) ? m.travel_time_s : 1e300;
+  row[13] = double(int(ind.contact));  // 0 push, 1 slide, 2 stick
+  row[14] = double(int(ind.kind));     // 0 sphere, 1 plate, 2 cylinder, 3 capsule
+  row[15] = ind.length_m;
+  row[16] = m.t0_s;
+  return row;
+}
+
+void Simulator::set_indenter_motion(std::size_t i, const IndenterMotion& motion) {
+  require(i < scene_.indenters.size(), "no indenter " + std::to_string(i) + " in the scene", "indenter");
+  motion_[i] = motion;
+  const std::vector<double> row = indenter_row(i);
+  const std::size_t offset = kIndenterStride * i * real_size_;
   if (precision_ == Precision::Double) {
-    cl_.queue.enqueueWriteBuffer(indenters_, CL_TRUE, first * sizeof(double), kIndenterStride * sizeof(double),
-                                 &table[first]);
+    cl_.queue.enqueueWriteBuffer(indenters_, CL_TRUE, offset, row.size() * sizeof(double), row.data());
   } else {
-    std::vector<float> row(kIndenterStride);
-    for (int k = 0; k < kIndenterStride; ++k) row[k] = float(std::clamp(table[first + k], -3e38, 3e38));
-    cl_.queue.enqueueWriteBuffer(indenters_, CL_TRUE, first * sizeof(float), row.size() * sizeof(float), row.data());
+    std::vector<float> f(row.size());
+    for (std::size_t k = 0; k < row.size(); ++k) f[k] = float(std::clamp(row[k], -3e38, 3e38));
+    cl_.queue.enqueueWriteBuffer(indenters_, CL_TRUE, offset, f.size() * sizeof(float), f.data());
+  }
+}
+
+void Simulator::follow_paths(double t) {
+  for (std::size_t i = 0; i < scene_.indenters.size(); ++i) {
+    const std::vector<PathKnot>& path = scene_.indenters[i].path;
+    if (path.size() < 2) continue;
+    std::size_t k = 0;  // the last segment starting at or before t (the first before the path starts)
+    while (k + 2 < path.size() && path[k + 1].time_s <= t) ++k;
+    if (k == path_segment_[i]) continue;
+    path_segment_[i] = k;
+    const double span = path[k + 1].time_s - path[k].time_s;
+    set_indenter_motion(i, {path[k].position_m, (path[k + 1].position_m - path[k].position_m) / span,
+                            path[k].time_s, span});
   }
 }
 
@@ -529,14 +561,8 @@ std::vector<double> Simulator::obstacle_table() const {
   std::vector<double> table(torus_table_base(), 0.0);
   const Eigen::Matrix3d Rt = lattice_.rotation.transpose();
   for (std::size_t i = 0; i < scene_.indenters.size(); ++i) {
-    const IndenterSpec& ind = scene_.indenters[i];
-    const IndenterPath& path = indenter_paths_[i];
-    double* row = &table[kIndenterStride * i];
-    const Vec3 start = Rt * path.start_m, normal = Rt * ind.normal, velocity = Rt * path.velocity_m_s;
-    for (int c = 0; c < 3; ++c) row[c] = start[c], row[4 + c] = normal[c], row[8 + c] = velocity[c];
-    row[3] = ind.kind == IndenterSpec::Kind::Plate ? -1.0 : ind.radius_m;
-    row[12] = std::isfinite(path.travel_time_s) ? path.travel_time_s : 1e300;
-    row[13] = double(int(ind.contact));  // 0 push, 1 slide, 2 stick
+    const std::vector<double> row = indenter_row(i);
+    std::copy(row.begin(), row.end(), table.begin() + kIndenterStride * i);
   }
   // Torus rows (kernels/device_contact.cl), then each torus's knots: time, minor and major
   // radius, and for the segment to the next knot 1/span and the two rates (0 for the last).
@@ -588,8 +614,11 @@ void Simulator::enqueue_check() const {
 void Simulator::advance(std::int64_t steps) {
   const bool indenter = !scene_.indenters.empty() || !scene_.tori.empty();  // obstacles that move in time
   const double dt = dt_.dt_s;
+  const bool has_paths = std::any_of(scene_.indenters.begin(), scene_.indenters.end(),
+                                     [](const IndenterSpec& ind) { return ind.path.size() >= 2; });
   for (std::int64_t s = 0; s < steps; ++s, ++steps_) {
     const double t0 = double(steps_) * dt, t1 = double(steps_ + 1) * dt;
+    if (has_paths) follow_paths(t0);
     if (scene_.solver.integrator == Integrator::Heun) {
       if (indenter) {
         set_indenter_args(predict_, kStepIndenter, t0, t1);

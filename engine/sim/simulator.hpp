@@ -2,6 +2,7 @@
 /// The OpenCL simulator: device buffers for one model, kernels built with only the features the
 /// scene uses, and time stepping without host synchronisation between checks.
 #include <CL/opencl.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -23,6 +24,24 @@ struct TorusContactCheck {
   double normal_force_sum_n = 0;      ///< Σ |normal force| over its contact elements (N)
   double peak_pressure_pa = 0;        ///< largest normal force over area share of one element
   double max_penetration_m = 0;       ///< deepest free element inside the tube (m)
+};
+
+/// Where an indenter is: start + velocity·clamp(t − t0, 0, travel) (world frame). The scene's
+/// constant-velocity press is one motion; a recorded trajectory is one per segment; a quasi-static
+/// press places the indenter with zero velocity.
+struct IndenterMotion {
+  Vec3 start_m = Vec3::Zero();
+  Vec3 velocity_m_s = Vec3::Zero();
+  double t0_s = 0;
+  double travel_time_s = 0;
+  Vec3 position_m(double t_s) const {
+    return start_m + velocity_m_s * std::clamp(t_s - t0_s, 0.0, travel_time_s);
+  }
+  /// From `from` at time t0 straight to `to`, reached at t1, then held (t1 ≤ t0: held at `to`).
+  static IndenterMotion straight(const Vec3& from, const Vec3& to, double t0_s, double t1_s) {
+    if (t1_s <= t0_s) return {to, Vec3::Zero(), 0, 0};
+    return {from, (to - from) / (t1_s - t0_s), t0_s, t1_s - t0_s};
+  }
 };
 
 /// Device-side reductions over the current state (see kernels/checks.cl).
@@ -92,13 +111,13 @@ class Simulator {
   std::int64_t steps() const { return steps_; }
   std::size_t device_bytes() const { return device_bytes_; }
   Precision precision() const { return precision_; }
-  /// position of indenter i at simulated time t (m)
+  /// position of indenter i at simulated time t (m): its current motion (a recorded trajectory:
+  /// the knots, interpolated)
   Vec3 indenter_position(std::size_t i, double t_s) const;
-  /// Replaces indenter i's path: from `from_m` at simulated time t0 it moves straight to `to_m`,
-  /// reached at t1 (> t0; t1 ≤ t0 jumps there), and holds (world frame, m). Rewrites only the
-  /// start, velocity and travel time of its row; for probes driven from outside the scene
-  /// (engine/haptic, force curves). Waits for the device queue.
-  void set_indenter_path(std::size_t i, const Vec3& from_m, const Vec3& to_m, double t0_s, double t1_s);
+  /// Moves indenter i from the next step on (rewrites its row of the obstacle table).
+  void set_indenter_motion(std::size_t i, const IndenterMotion& motion);
+  /// Holds indenter i still at a world point (m) from the next step on: quasi-static probing.
+  void place_indenter(std::size_t i, const Vec3& position_m) { set_indenter_motion(i, {position_m, Vec3::Zero(), 0, 0}); }
   /// [[device.torus]] only: each element's surface-area share (m², rest; 0 off the surface) that
   /// contact pressures divide by
   const std::vector<double>& contact_area_m2() const { return contact_area_host_; }
@@ -106,6 +125,10 @@ class Simulator {
 
  private:
   void set_indenter_args(cl::Kernel& k, int first_arg, double t_force, double t_project);
+  /// one indenter's row of the obstacle table (lattice frame, kernels/common.cl)
+  std::vector<double> indenter_row(std::size_t i) const;
+  /// recorded trajectories: switches each indenter's row to the segment holding time t
+  void follow_paths(double t_s);
   void set_lattice_args(cl::Kernel& k, int first_arg);
   /// arguments 1–7 of the per-element gradient fits (tissue ids, materials, grid, spacing)
   void set_element_fit_args(cl::Kernel& k);
@@ -131,15 +154,8 @@ class Simulator {
   /// read-only buffer of reals in the run's precision
   cl::Buffer make_real_buffer(const std::vector<double>& values) const;
 
-  /// One indenter's straight path: position start + velocity·min(t, travel_time) (world, m)
-  struct IndenterPath {
-    Vec3 start_m, velocity_m_s;
-    double travel_time_s;
-  };
-
   const Scene& scene_;
   const Lattice& lattice_;
-  std::vector<IndenterPath> indenter_paths_;  ///< the scene's paths, or set_indenter_path's
   const ClContext& cl_;
   Precision precision_;
   std::size_t n_;
@@ -156,6 +172,8 @@ class Simulator {
   bool hyper_ = false;
   cl::Buffer tissue_, materials_, Q_, F_;
   cl::Buffer indenters_;  ///< rigid-obstacle table: indenters and tori (lattice frame)
+  std::vector<IndenterMotion> motion_;  ///< per indenter, what its row holds now
+  std::vector<std::size_t> path_segment_;  ///< per indenter with a trajectory: the segment its row holds
   cl::Buffer contact_area_;  ///< [[device.torus]]: per element surface-area share (m²)
   std::vector<double> contact_area_host_;
   int check_slots_ = 0;  ///< hyperelastic: tissue ids, law table, Q and F rows

@@ -159,5 +159,31 @@ if ! "$bin" simulate "$work/corrupt/scene.toml" --out "$work/corrupt/out" --quie
   pass "truncated CT: $(cat "$work/corrupt.err")"
 else fail "truncated CT"; cat "$work/corrupt.err"; fi
 
+# --- voxbreast probe: settle under gravity, then a line of 3 presses (docs/PROBING.md)
+{ scene | sed 's/^max = \[0.01, 0.01, 0.01\]/max = [0.016, 0.012, 0.01]/'
+  printf '[solver]\nintegrator = "relaxation"\n[[indenter]]\nkind = "capsule"\nradius = 0.003\nlength = 0.004\naxis = [0, 1, 0]\n'
+  printf '[probe]\nfrom = [0.003, 0.004, 0.05]\nto = [0.013, 0.004, 0.05]\npresses = 3\ndepth = 0.001\nsteps = 2\nat_force = [0.005]\n'
+} >"$work/probe.toml"
+if "$bin" probe "$work/probe.toml" --out "$work/probe" --quiet >"$work/probe.txt" 2>&1 && python3 - "$work/probe" <<'PY'
+import csv, json, sys
+d = sys.argv[1]
+s = json.load(open(d + "/probe_summary.json"))
+assert s["settle"]["converged"] and s["settle"]["max_displacement_mm"] > 0, s["settle"]
+assert s["unconverged_increments"] == 0 and len(s["presses"]) == 3, s
+curves = list(csv.DictReader(open(d + "/probe_curves.csv")))
+assert len(curves) == 3 * 3, len(curves)
+assert all(float(r["press_force_n"]) > 0 for r in curves if float(r["depth_mm"]) > 0), curves
+profile = list(csv.DictReader(open(d + "/probe_profile.csv")))
+assert [r["press"] for r in profile] == ["1", "2", "3"] and "depth_at_0.005N_mm" in profile[0], profile
+assert all(float(r["contact_area_mm2"]) > 0 for r in profile), profile
+PY
+then pass "probe: settles, 3 presses, curves, profile and summary"
+else fail "probe"; cat "$work/probe.txt"; fi
+scene >"$work/noprobe.toml"
+if ! "$bin" probe "$work/noprobe.toml" --out "$work/noprobe" --quiet 2>"$work/noprobe.err" \
+   && grep -q "^voxbreast: error:.*no \[probe\] section" "$work/noprobe.err"; then
+  pass "probe without [probe]: $(cat "$work/noprobe.err")"
+else fail "probe without [probe]"; cat "$work/noprobe.err"; fi
+
 echo "$passes passed, $failures failed"
 [[ $failures -eq 0 ]]
