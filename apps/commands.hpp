@@ -16,5 +16,6 @@ Command add_simulate(CLI::App& app);
 Command add_bench(CLI::App& app);
 Command add_phantom(CLI::App& app);
 Command add_sweep(CLI::App& app);
+Command add_fit(CLI::App& app);
 
 }  // namespace vb::app

@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   const vb::app::Command commands[] = {vb::app::add_info(app), vb::app::add_simulate(app),
                                        vb::app::add_bench(app), vb::app::add_phantom(app),
-                                       vb::app::add_sweep(app)};
+                                       vb::app::add_sweep(app), vb::app::add_fit(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
