@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "apps/commands.hpp"
+#include "apps/fit_batch.hpp"
 #include "apps/fit_pipeline.hpp"
 #include "apps/simulation_setup.hpp"
 #include "engine/error.hpp"
@@ -13,7 +14,8 @@ namespace vb::app {
 namespace {
 
 struct FitCommandOptions {
-  std::string scene, out, device, precision, truth, make_observation;
+  std::string scene, out, device, precision, truth, make_observation, cases, devices;
+  bool retry_failed = false;
   double noise_mm = 0;
   std::uint64_t seed = 1;
   int stop_after = 0;
@@ -21,6 +23,20 @@ struct FitCommandOptions {
 };
 
 int run_fit_command(const FitCommandOptions& o) {
+  if (!o.cases.empty()) {
+    require(o.scene.empty() && !o.out.empty(), "--cases runs the scenes of a list: give no scene file, and --out",
+            "voxbreast fit --cases", "voxbreast fit --cases cases.csv --out DIR");
+    FitBatchOptions b;
+    b.cases_csv = o.cases;
+    b.out = o.out;
+    b.devices = o.devices.empty() ? o.device : o.devices;
+    b.stop_after = std::size_t(o.stop_after);
+    b.retry_failed = o.retry_failed;
+    b.quiet = o.quiet;
+    b.plots = !o.no_plots;
+    return run_fit_batch(b);
+  }
+  require(!o.scene.empty(), "a scene file (or --cases) is needed", "voxbreast fit", "voxbreast fit SCENE.toml --out DIR");
   const Scene scene = load_scene(o.scene, o.precision);
   require(!o.out.empty() || !o.make_observation.empty(), "--out is required", "voxbreast fit", "give --out DIR");
   const ClContext cl(select_device(o.device));
@@ -59,7 +75,11 @@ int run_fit_command(const FitCommandOptions& o) {
 Command add_fit(CLI::App& app) {
   auto o = std::make_shared<FitCommandOptions>();
   auto* sub = app.add_subcommand("fit", "Estimate tissue elasticity from an observed posture change ([fit], docs/FIT.md)");
-  sub->add_option("scene", o->scene, "scene file (TOML) with a [fit] table")->required()->check(CLI::ExistingFile);
+  sub->add_option("scene", o->scene, "scene file (TOML) with a [fit] table")->check(CLI::ExistingFile);
+  sub->add_option("--cases", o->cases, "batch: a CSV with a 'scene' column (and optional 'truth'), one fit per row")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--devices", o->devices, "batch: OpenCL devices, one worker each (as `sweep --devices`)");
+  sub->add_flag("--retry-failed", o->retry_failed, "batch: run failed cases again");
   sub->add_option("--out,-o", o->out, "output folder (restarting into it resumes the fit)");
   sub->add_option("--truth", o->truth, "true displacement field (NIfTI): summary.json compares the fit with it")
       ->check(CLI::ExistingFile);
@@ -70,7 +90,7 @@ Command add_fit(CLI::App& app) {
   sub->add_option("--seed", o->seed, "with --make-observation: seed of the noise (default 1)");
   sub->add_option("--device,-d", o->device, "OpenCL device: gpu, cpu, an index or a name (default $VOXBREAST_DEVICE, else first GPU)");
   sub->add_option("--precision", o->precision, "override solver.precision")->check(CLI::IsMember({"float", "double"}));
-  sub->add_option("--stop-after", o->stop_after, "stop after N more iterations (resumable); for tests");
+  sub->add_option("--stop-after", o->stop_after, "stop after N more iterations (batch: N cases per process); resumable");
   sub->add_flag("--no-plots", o->no_plots, "do not draw history.png");
   sub->add_flag("--quiet,-q", o->quiet, "no per-iteration lines");
   return {sub, [o] { return run_fit_command(*o); }};

@@ -16,6 +16,7 @@ std::vector<std::string> split_fields(const std::string& line) {
     const auto b = field.find_first_not_of(" \t\r"), e = field.find_last_not_of(" \t\r");
     out.push_back(b == std::string::npos ? "" : field.substr(b, e - b + 1));
   }
+  if (!line.empty() && line.back() == ',') out.emplace_back();  // getline drops a trailing empty field
   return out;
 }
 
