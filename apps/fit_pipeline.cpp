@@ -1,6 +1,7 @@
 #include "apps/fit_pipeline.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -126,6 +127,25 @@ void unobserve_held(Observation& obs, const ElementArrays& elements) {
     if (elements.inverse_mass[e] == 0) obs.weight_per_m2[e] = 0;
 }
 
+/// The warm-start state beside checkpoint.json: raw doubles (from, then to), named by iteration
+/// so the JSON, written after it, always names a complete file.
+void write_state(const std::string& path, const FitProgress& p) {
+  std::string bytes(sizeof(double) * (p.state_from_m.size() + p.state_to_m.size()), '\0');
+  std::memcpy(bytes.data(), p.state_from_m.data(), sizeof(double) * p.state_from_m.size());
+  std::memcpy(bytes.data() + sizeof(double) * p.state_from_m.size(), p.state_to_m.data(),
+              sizeof(double) * p.state_to_m.size());
+  write_text_atomically(path, bytes);
+}
+
+void read_state(const std::string& path, std::size_t values, FitProgress& p) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<double> all(2 * values);
+  in.read(reinterpret_cast<char*>(all.data()), std::streamsize(sizeof(double) * all.size()));
+  require(bool(in), "the fit's saved state is missing or short", path, "delete the folder to start the fit over");
+  p.state_from_m.assign(all.begin(), all.begin() + std::ptrdiff_t(values));
+  p.state_to_m.assign(all.begin() + std::ptrdiff_t(values), all.end());
+}
+
 std::string fingerprint(const Scene& scene) {
   return std::to_string(std::hash<std::string>{}(scene.source_text));
 }
@@ -165,13 +185,22 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
             "the folder holds the checkpoint of another fit", checkpoint_path,
             "use another --out folder or delete it to start over");
     progress = progress_from_json(saved.at("progress"));
+    if (const std::string state = saved.value("state", ""); !state.empty())
+      read_state(dir + "/" + state, 3 * forward.lattice().element_count(), progress);
   }
   const std::size_t done_before = progress.history.size();
   std::size_t reported = done_before;
   struct Stop {};
   const FitCheckpoint checkpoint = [&](const FitProgress& p) {
-    json j = {{"fingerprint", fingerprint(scene)}, {"regions", regions.size()}, {"progress", progress_to_json(p)}};
+    const std::string state = p.state_to_m.empty() ? "" : "state-" + std::to_string(p.history.size()) + ".bin";
+    if (!state.empty()) write_state(dir + "/" + state, p);
+    json j = {{"fingerprint", fingerprint(scene)}, {"regions", regions.size()}, {"progress", progress_to_json(p)},
+              {"state", state}};
     write_text_atomically(checkpoint_path, j.dump(1));
+    for (const auto& f : std::filesystem::directory_iterator(dir)) {  // older states
+      const std::string name = f.path().filename().string();
+      if (name.rfind("state-", 0) == 0 && name != state) std::filesystem::remove(f.path());
+    }
     write_text_atomically(dir + "/history.csv", history_csv(p, regions));
     if (options.on_iteration && p.history.size() > reported) options.on_iteration(p.history.back());
     reported = p.history.size();
@@ -189,6 +218,14 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
     }
   }
   if (stopped) return {{"finished", false}};
+  // Finished: the warm-start state is no longer needed.
+  progress.state_from_m.clear();
+  progress.state_to_m.clear();
+  write_text_atomically(checkpoint_path, json({{"fingerprint", fingerprint(scene)}, {"regions", regions.size()},
+                                               {"progress", progress_to_json(progress)}, {"state", ""}})
+                                             .dump(1));
+  for (const auto& f : std::filesystem::directory_iterator(dir))
+    if (f.path().filename().string().rfind("state-", 0) == 0) std::filesystem::remove(f.path());
 
   // Final outputs from the result's forward solve.
   const std::vector<double>& E = progress.history.back().modulus_pa;

@@ -24,6 +24,9 @@ struct FitProgress {
   std::vector<double> modulus_pa;          ///< current per-region moduli (Pa)
   std::vector<double> lower_log, upper_log;  ///< bisection: each region's bracket (ln Pa)
   double lm_damping = 1e-3;
+  /// The forward solution the next iteration starts from (n×3 each, m): saved so a resumed fit
+  /// continues exactly as an uninterrupted one would (empty: solve afresh).
+  std::vector<double> state_from_m, state_to_m;
   std::vector<FitIteration> history;
   bool finished = false;
   std::string stop_reason;

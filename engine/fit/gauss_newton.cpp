@@ -78,7 +78,18 @@ FitProgress run_gauss_newton(const FitProblem& p, FitProgress progress, const Fi
   const double lo = std::log(p.min_pa), hi = std::log(p.max_pa);
   if (progress.history.empty()) progress.modulus_pa = p.initial_pa;
   std::vector<double> E = progress.modulus_pa;
-  ForwardSolution base = model.solve(E);
+  ForwardSolution base;
+  if (progress.state_to_m.empty()) {
+    base = model.solve(E);
+  } else {  // resumed: the accepted solution of the last iteration
+    base.from_m = progress.state_from_m;
+    base.to_m = progress.state_to_m;
+  }
+  const auto keep_state = [&] {
+    progress.state_from_m = base.from_m;
+    progress.state_to_m = base.to_m;
+  };
+  keep_state();
   FitIteration current = evaluate_fit(p, base.change_m(), E);
   if (progress.history.empty()) {
     current.iteration = 0;
@@ -134,6 +145,7 @@ FitProgress run_gauss_newton(const FitProblem& p, FitProgress progress, const Fi
         progress.history.push_back(current);
         progress.modulus_pa = E;
         progress.lm_damping = mu;
+        keep_state();
         if (decrease < p.spec.tolerance) {
           finish(progress, "cost fell by less than fit.tolerance", checkpoint);
           return progress;
@@ -166,7 +178,9 @@ FitProgress run_bisection(const FitProblem& p, FitProgress progress, const FitCh
   }
   const std::vector<std::int32_t>& region = model.regions().region_of_element;
   ForwardSolution last;
-  bool have_last = false;
+  last.from_m = progress.state_from_m;
+  last.to_m = progress.state_to_m;
+  bool have_last = !last.to_m.empty();
   // progress.modulus_pa is always the next state to evaluate; history holds evaluated ones.
   for (;;) {
     ForwardSolution s = model.solve(progress.modulus_pa, have_last ? &last : nullptr);
@@ -201,6 +215,8 @@ FitProgress run_bisection(const FitProblem& p, FitProgress progress, const FitCh
       finish(progress, "every bracket narrower than 0.1%", checkpoint);
       return progress;
     }
+    progress.state_from_m = last.from_m;
+    progress.state_to_m = last.to_m;
     if (checkpoint) checkpoint(progress);
   }
   progress.modulus_pa = progress.history.back().modulus_pa;
