@@ -39,7 +39,9 @@ struct FitSpec {
   double regularisation = 1e-6;  ///< Tikhonov weight α on Σ (ln E − ln E_initial)² (docs/FIT.md)
   double step_log = 0.05;        ///< finite-difference step of the Jacobian in log E
   double tolerance = 1e-4;       ///< stop when the cost falls by less than this fraction
-  double equilibrium = 1e-7;     ///< forward solves' residual tolerance (overrides stop.equilibrium)
+  /// forward solves' residual tolerance (overrides stop.equilibrium); 0: 1e-7 in double
+  /// precision, 1e-5 in float (whose rounding floor lies near 1e-6)
+  double equilibrium = 0;
   std::int64_t max_steps = 50000;  ///< per forward solve and posture
 
   int line = 0;

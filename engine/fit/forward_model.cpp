@@ -27,7 +27,8 @@ ForwardModel::ForwardModel(const Scene& scene, const Lattice& lattice, const Fit
     scene_.solver.integrator = Integrator::Relaxation;
     scene_.solver.dt_safety = 0.9;  // the scene parser's relaxation default
   }
-  scene_.stop.equilibrium = fit.equilibrium;
+  scene_.stop.equilibrium =
+      fit.equilibrium > 0 ? fit.equilibrium : scene.solver.precision == Precision::Double ? 1e-7 : 1e-5;
   scene_.stop.max_steps = fit.max_steps;
   scene_.stop.max_time_s = INFINITY;
 
