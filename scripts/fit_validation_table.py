@@ -13,33 +13,43 @@ TRUE_E = {"dcis": 16400.0, "idc": 20000.0, "fibroadenoma": 6400.0}
 
 def main():
     out, spacing = sys.argv[1], sys.argv[2]
-    with open(os.path.join(out, "batch", "metrics.csv"), newline="") as f:
-        rows = list(csv.DictReader(f))
-    with open(os.path.join(out, "batch", "timing.csv"), newline="") as f:
-        timing = {r["case"]: r for r in csv.DictReader(f)}
+    # From the case folders (a batch stopped midway still gives the finished cases).
+    cases_dir = os.path.join(out, "batch", "cases")
+    rows = []
+    for case in sorted(c for c in os.listdir(cases_dir) if c.isdigit()):
+        with open(os.path.join(cases_dir, case, "case.json")) as f:
+            info = json.load(f)
+        row = {"case": case, "scene": info["values"]["scene"].strip("'\""), "status": info["status"],
+               "error": info["error"], "wall_time_s": info["wall_time_s"]}
+        if info["status"] == "ok":
+            with open(os.path.join(cases_dir, case, "summary.json")) as f:
+                row["summary"] = json.load(f)
+        rows.append(row)
     lines = ["| case | tumour elements | variant | tumour E fitted (kPa) | true (kPa) | error | adipose error | "
              "fibroglandular error | initial RMS vs obs. (mm) | initial within 1 mm of obs. | within 1 mm of truth | "
              "RMS vs truth (mm) | max vs truth (mm) | iterations | forward solves | wall (s) |",
              "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     points = []
     for r in rows:
-        m = re.match(r'"?cases/(\w+?)_r(\d+)/(\w+)\.toml"?', r["scene"])
+        m = re.match(r'cases/(\w+?)_r(\d+)/(\w+)\.toml', r["scene"])
         if not m or r["status"] != "ok":
             lines.append(f"| {r['scene']} | | | {r['status']} {r['error']} |")
             continue
         kind, radius, variant = m.group(1), m.group(2), m.group(3)
         true_e = TRUE_E[kind]
-        fit_e = float(r["modulus_pa.tumour.fitted_E_pa"])
+        d = r["summary"]
+        mod = d["modulus_pa"]
+        fit_e = mod["tumour"]["fitted_E_pa"]
         err = fit_e / true_e - 1
-        ad = float(r["modulus_pa.adipose.fitted_E_pa"]) / 3250 - 1
-        fg = float(r["modulus_pa.fibroglandular.fitted_E_pa"]) / 6000 - 1
-        within = float(r["truth.within_1mm"])
-        wall = float(timing.get(r["case"], {}).get("wall_time_s", "nan") or "nan")
-        lines.append(f"| {kind} r = {radius} mm | {r['modulus_pa.tumour.elements']} | {variant} | {fit_e / 1e3:.2f} | "
+        ad = mod["adipose"]["fitted_E_pa"] / 3250 - 1
+        fg = mod["fibroglandular"]["fitted_E_pa"] / 6000 - 1
+        within = d["truth"]["within_1mm"]
+        wall = r["wall_time_s"]
+        lines.append(f"| {kind} r = {radius} mm | {mod['tumour']['elements']} | {variant} | {fit_e / 1e3:.2f} | "
                      f"{true_e / 1e3:.1f} | {100 * err:+.1f}% | {100 * ad:+.2f}% | {100 * fg:+.2f}% | "
-                     f"{float(r['initial.rms_mm']):.3f} | {100 * float(r['initial.within_1mm']):.2f}% | "
-                     f"{100 * within:.2f}% | {float(r['truth.rms_mm']):.4f} | {float(r['truth.max_mm']):.3f} | "
-                     f"{r['iterations']} | {r['forward_solves']} | "
+                     f"{d['initial']['rms_mm']:.3f} | {100 * d['initial']['within_1mm']:.2f}% | "
+                     f"{100 * within:.2f}% | {d['truth']['rms_mm']:.4f} | {d['truth']['max_mm']:.3f} | "
+                     f"{d['iterations']} | {d['forward_solves']} | "
                      f"{wall:.1f} |")
         points.append((f"{kind}\nr{radius}", variant, err))
     text = f"Lattice spacing {spacing} mm.\n\n" + "\n".join(lines) + "\n"
