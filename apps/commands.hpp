@@ -19,5 +19,6 @@ Command add_sweep(CLI::App& app);
 Command add_haptic(CLI::App& app);
 Command add_fit_curve(CLI::App& app);
 Command add_probe(CLI::App& app);
+Command add_fit(CLI::App& app);
 
 }  // namespace vb::app

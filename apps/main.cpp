@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
   const vb::app::Command commands[] = {vb::app::add_info(app), vb::app::add_simulate(app),
                                        vb::app::add_bench(app), vb::app::add_phantom(app),
                                        vb::app::add_sweep(app), vb::app::add_haptic(app),
-                                       vb::app::add_fit_curve(app), vb::app::add_probe(app)};
+                                       vb::app::add_fit_curve(app), vb::app::add_probe(app), vb::app::add_fit(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

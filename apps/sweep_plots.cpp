@@ -13,10 +13,14 @@ extern char** environ;
 
 namespace vb::app {
 
-std::string draw_sweep_plots(const std::string& sweep_dir) {
-  const char* env = std::getenv("VOXBREAST_PLOT_SWEEP");
-  const std::string script = env ? env : std::string(config::source_dir) + "/scripts/plot_sweep.py";
-  const std::string by_hand = "draw them with: python3 scripts/plot_sweep.py " + sweep_dir;
+namespace {
+
+/// Runs `python3 SCRIPT DIR` (the script from $env_var, else scripts/NAME in the source tree);
+/// returns "" on success, else a line saying what happened and how to draw the plot by hand.
+std::string run_plot_script(const char* env_var, const std::string& name, const std::string& sweep_dir) {
+  const char* env = std::getenv(env_var);
+  const std::string script = env ? env : std::string(config::source_dir) + "/scripts/" + name;
+  const std::string by_hand = "draw them with: python3 scripts/" + name + " " + sweep_dir;
   if (!std::filesystem::is_regular_file(script)) return "plots: " + script + " not found; " + by_hand;
   // Debian's interpreter first: it has python3-matplotlib (scripts/setup.sh); else the PATH's.
   const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
@@ -33,5 +37,13 @@ std::string draw_sweep_plots(const std::string& sweep_dir) {
   if (WEXITSTATUS(status) == 77) return "plots: skipped (matplotlib missing); " + by_hand;
   return "plots: the plot script failed (exit " + std::to_string(WEXITSTATUS(status)) + "); " + by_hand;
 }
+
+}  // namespace
+
+std::string draw_sweep_plots(const std::string& sweep_dir) {
+  return run_plot_script("VOXBREAST_PLOT_SWEEP", "plot_sweep.py", sweep_dir);
+}
+
+std::string draw_fit_plot(const std::string& fit_dir) { return run_plot_script("VOXBREAST_PLOT_FIT", "plot_fit.py", fit_dir); }
 
 }  // namespace vb::app

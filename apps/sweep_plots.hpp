@@ -9,4 +9,8 @@ namespace vb::app {
 /// the sweep's results are complete without them.
 std::string draw_sweep_plots(const std::string& sweep_dir);
 
+/// history.png of a fit folder, drawn by scripts/plot_fit.py ($VOXBREAST_PLOT_FIT overrides);
+/// "" when drawn, else what happened.
+std::string draw_fit_plot(const std::string& fit_dir);
+
 }  // namespace vb::app

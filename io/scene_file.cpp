@@ -992,7 +992,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
   const Section top(root, "", source_name);
   top.check_keys(
       {"model", "materials", "solver", "gravity", "anchor", "indenter", "device", "positioning", "track", "stop",
-       "output", "volume", "reference_state", "reproducibility", "probe"});
+       "output", "volume", "reference_state", "reproducibility", "probe", "fit"});  // [fit]: read by `voxbreast fit` (io/fit_file.hpp)
   Scene scene;
   scene.model = read_model(top.table_or_empty("model"));
   scene.materials = read_materials(top.table_or_empty("materials"));

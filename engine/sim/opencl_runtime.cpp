@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
+#include <mutex>
 
 #include "engine/error.hpp"
 
@@ -125,6 +127,16 @@ cl::Program build_program(const ClContext& cl, const std::vector<std::string>& f
     std::filesystem::create_directories(dir);
     std::ofstream(std::filesystem::path(dir) / "program.cl") << "// options: " << options << "\n" << source;
   }
+  // Built programs are kept per context for the process: a fit builds one Simulator per forward
+  // solve with the same source and options (docs/FIT.md). A cached program retains its context,
+  // so a context's address is never reused while its entry exists.
+  static std::mutex cache_mutex;
+  static std::map<std::pair<cl_context, std::string>, cl::Program> cache;
+  const std::pair<cl_context, std::string> key{cl.context(), options + "\n" + source};
+  {
+    const std::lock_guard<std::mutex> lock(cache_mutex);
+    if (const auto it = cache.find(key); it != cache.end()) return it->second;
+  }
   cl::Program program(cl.context, source);
   try {
     program.build({cl.info.device}, options.c_str());
@@ -139,6 +151,8 @@ cl::Program build_program(const ClContext& cl, const std::vector<std::string>& f
                     "':\n" + trim(log),
                 cl.info.name, "set VOXBREAST_DUMP_KERNELS=DIR to write the full source");
   }
+  const std::lock_guard<std::mutex> lock(cache_mutex);
+  cache.emplace(key, program);
   return program;
 }
 

@@ -38,6 +38,7 @@ struct ClContext {
 /// order, after `prelude_front` (inserted after the first file). Each file keeps its own line
 /// numbers in compiler messages. On failure throws vb::Error carrying the build log. When
 /// $VOXBREAST_DUMP_KERNELS names a folder, the final source and options are written there.
+/// Programs are cached per context and (source, options) for the life of the process.
 cl::Program build_program(const ClContext& cl, const std::vector<std::string>& files,
                           const std::string& prelude_after_first, const std::string& options);
 

@@ -1,0 +1,59 @@
+#pragma once
+/// The forward model of a fit: region moduli → the displacement of the posture change, solved to
+/// static equilibrium with dynamic relaxation (docs/FIT.md, "Forward model").
+#include <cstdint>
+#include <vector>
+
+#include "engine/fit/fit_regions.hpp"
+#include "engine/sim/element_setup.hpp"
+#include "engine/sim/opencl_runtime.hpp"
+
+namespace vb {
+
+struct ForwardSolution {
+  std::vector<double> from_m;  ///< n×3 equilibrium displacement in the `from` posture (m, world); zeros without one
+  std::vector<double> to_m;    ///< n×3 equilibrium displacement in the scene's posture (m, world)
+  std::int64_t steps = 0;      ///< relaxation steps of both postures
+  /// the displacement of the posture change: to − from (n×3, m)
+  std::vector<double> change_m() const;
+};
+
+class ForwardModel {
+ public:
+  /// Copies the scene and switches it to relaxation with the fit's tolerance. Tissues with fitted
+  /// regions are split into one tissue per (tissue, region) unless regions are elements (then
+  /// only linear and biphasic springs, whose per-element E the kernels read directly). Throws
+  /// vb::Error without [gravity] or for more than 255 (tissue, region) pairs.
+  ForwardModel(const Scene& scene, const Lattice& lattice, const FitRegions& regions, const FitSpec& fit,
+               const ClContext& cl);
+
+  /// Solves both postures with these region moduli (Pa). `warm`: start from its states (fewer
+  /// steps when the moduli changed little). Throws vb::Error when a posture does not reach
+  /// equilibrium in fit.max_steps.
+  ForwardSolution solve(const std::vector<double>& region_modulus_pa, const ForwardSolution* warm = nullptr) const;
+
+  /// Every element's Young's modulus with these region moduli (n, Pa): the map the fit writes.
+  std::vector<double> element_modulus(const std::vector<double>& region_modulus_pa) const;
+
+  const FitRegions& regions() const { return regions_; }
+  const Lattice& lattice() const { return split_ ? split_lattice_ : lattice_; }
+  std::size_t forward_solves() const { return solves_; }
+
+ private:
+  ElementArrays arrays(const std::vector<double>& region_modulus_pa) const;
+
+  mutable Scene scene_;  ///< relaxation; split tissues' moduli change per solve
+  const Lattice& lattice_;
+  const FitRegions& regions_;
+  FitSpec fit_;
+  const ClContext& cl_;
+  bool split_ = false;
+  Lattice split_lattice_;
+  /// split tissue → (region or −1, material name of the original tissue)
+  std::vector<std::pair<std::int32_t, std::string>> split_origin_;
+  ElementArrays base_;  ///< element path: the model's arrays
+  std::vector<double> base_modulus_;  ///< n: E of each element's own material
+  mutable std::size_t solves_ = 0;
+};
+
+}  // namespace vb

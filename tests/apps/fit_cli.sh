@@ -1,0 +1,160 @@
+#!/usr/bin/env bash
+# End-to-end checks of `voxbreast fit` (docs/FIT.md) on a 6 mm phantom (6,505 elements) with one
+# DCIS tumour (16.4 kPa), the observation made by the forward model itself (the paper's protocol):
+#   accuracy — Gauss-Newton recovers the tumour modulus within 10% and 99% of the elements move
+#              within 1 mm of the truth; also with 0.5 mm noise (displacements only), with the
+#              neo-Hookean forward model, and with the per-region bisection; bad input fails
+#   resume   — a fit stopped (--stop-after) or killed (kill -9) and restarted gives the same
+#              history and moduli as an uninterrupted one; a killed batch resumes and writes the
+#              same metrics.csv as an uninterrupted batch
+#   mpi      — a 2-rank `mpirun` batch writes the same metrics.csv as the serial batch
+#   VOXBREAST_BIN=build/apps/voxbreast VOXBREAST_DEVICE=cpu bash tests/apps/fit_cli.sh . accuracy
+set -uo pipefail
+root=${1:?source dir}
+mode=${2:?accuracy, resume or mpi}
+bin=${VOXBREAST_BIN:?path to voxbreast}
+py=$([[ -x /usr/bin/python3 ]] && echo /usr/bin/python3 || echo python3)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+failures=0
+passes=0
+pass() { passes=$((passes + 1)); echo "ok   $1"; }
+fail() { failures=$((failures + 1)); echo "FAIL $1"; }
+json() { "$py" -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$1" "$2"; }
+check() {  # name, python condition on the summary d
+  if [[ $("$py" -c "import json,sys; d=json.load(open(sys.argv[1])); print(bool($3))" "$2" 2>&1) == True ]]; then pass "$1"
+  else fail "$1"; head -c 1500 "$2"; fi
+}
+
+"$bin" phantom --out "$work/ph" --spacing 6 --tumour dcis,10,-25,5,9 >/dev/null || { fail "phantom"; exit 1; }
+scene() {  # name, tumour law block, observation file, extra [fit] lines
+  cat >"$work/ph/$1.toml" <<TOML
+[model]
+image = "ct.nii.gz"
+labels = "labels.nii.gz"
+keep = ["skin", "adipose", "fibroglandular", "muscle", "tumour"]
+[model.label_table]
+1 = "skin"
+2 = "adipose"
+3 = "fibroglandular"
+4 = "muscle"
+5 = "bone"
+6 = "tumour"
+[materials.muscle]
+rigid = true
+[materials.skin]
+E = 40000.0
+$2
+[solver]
+integrator = "relaxation"
+precision = "double"
+check_every = 10
+[gravity]
+posture = "prone"
+[fit]
+from_posture = "supine"
+dvf = "$3"
+tissues = ["adipose", "fibroglandular", "tumour"]
+$4
+TOML
+}
+linear='[materials.tumour]
+E = 16400.0'
+scene truth "$linear" truth.nii.gz ""
+"$bin" fit "$work/ph/truth.toml" --make-observation "$work/ph/truth.nii.gz" >/dev/null || fail "--make-observation"
+
+case $mode in
+accuracy)
+  "$bin" fit "$work/ph/truth.toml" --out "$work/gn" --truth "$work/ph/truth.nii.gz" --no-plots -q >"$work/gn.txt" 2>&1 \
+    || { fail "fit"; cat "$work/gn.txt"; }
+  s="$work/gn/summary.json"
+  echo "     tumour $(json "$s" "round(d['modulus_pa']['tumour']['fitted_E_pa'])") Pa (truth 16400), adipose $(json "$s" "round(d['modulus_pa']['adipose']['fitted_E_pa'])") (3250), fibroglandular $(json "$s" "round(d['modulus_pa']['fibroglandular']['fitted_E_pa'])") (6000); $(json "$s" "d['forward_solves']") forward solves"
+  check "Gauss-Newton: tumour modulus within 10% of 16.4 kPa" "$s" "abs(d['modulus_pa']['tumour']['fitted_E_pa'] / 16400 - 1) <= 0.10"
+  check "Gauss-Newton: adipose and fibroglandular within 2%" "$s" \
+    "abs(d['modulus_pa']['adipose']['fitted_E_pa'] / 3250 - 1) <= 0.02 and abs(d['modulus_pa']['fibroglandular']['fitted_E_pa'] / 6000 - 1) <= 0.02"
+  check "Gauss-Newton: >= 99% of elements within 1 mm of the truth, RMS below 0.01 mm" "$s" \
+    "d['truth']['within_1mm'] >= 0.99 and d['truth']['rms_mm'] < 0.01 and d['final']['rms_mm'] < d['initial']['rms_mm']"
+  for f in elasticity.nii.gz displacement.nii.gz residual_mm.nii.gz history.csv regions.csv checkpoint.json; do
+    [[ -s "$work/gn/$f" ]] || fail "output $f"
+  done
+  [[ $(tail -n +2 "$work/gn/history.csv" | wc -l) -ge 2 ]] && pass "history.csv has a row per iteration" || fail "history.csv"
+
+  "$bin" fit "$work/ph/truth.toml" --make-observation "$work/ph/noisy.nii.gz" --noise-mm 0.5 --seed 3 >/dev/null
+  scene noisy "$linear" noisy.nii.gz 'sigma_mm = 0.5'
+  "$bin" fit "$work/ph/noisy.toml" --out "$work/noisy" --truth "$work/ph/truth.nii.gz" --no-plots -q >/dev/null 2>&1 || fail "noisy fit"
+  s="$work/noisy/summary.json"
+  echo "     0.5 mm noise: tumour $(json "$s" "round(d['modulus_pa']['tumour']['fitted_E_pa'])") Pa, truth RMS $(json "$s" "round(d['truth']['rms_mm'], 4)") mm"
+  check "0.5 mm noise: >= 99% of elements within 1 mm of the truth" "$s" "d['truth']['within_1mm'] >= 0.99"
+
+  nh='[materials.tumour]
+law = "neo-hookean"
+E = 16400.0
+[materials.adipose]
+law = "neo-hookean"
+E = 3250.0
+[materials.fibroglandular]
+law = "neo-hookean"
+E = 6000.0'
+  scene nh "$nh" nh.nii.gz ""
+  "$bin" fit "$work/ph/nh.toml" --make-observation "$work/ph/nh.nii.gz" >/dev/null
+  "$bin" fit "$work/ph/nh.toml" --out "$work/nh" --truth "$work/ph/nh.nii.gz" --no-plots -q >/dev/null 2>&1 || fail "neo-Hookean fit"
+  check "neo-Hookean: tumour within 10%, >= 99% within 1 mm" "$work/nh/summary.json" \
+    "abs(d['modulus_pa']['tumour']['fitted_E_pa'] / 16400 - 1) <= 0.10 and d['truth']['within_1mm'] >= 0.99"
+
+  scene bis "$linear" truth.nii.gz 'method = "bisection"'
+  "$bin" fit "$work/ph/bis.toml" --out "$work/bis" --truth "$work/ph/truth.nii.gz" --no-plots -q >/dev/null 2>&1 || fail "bisection fit"
+  check "bisection: converges (brackets closed), >= 99% within 1 mm" "$work/bis/summary.json" \
+    "d['truth']['within_1mm'] >= 0.99 and 'bracket' in d['stop_reason']"
+
+  scene bad "$linear" truth.nii.gz 'regions = "voxels"'
+  "$bin" fit "$work/ph/bad.toml" --out "$work/bad" >"$work/bad.txt" 2>&1
+  [[ $? -ne 0 ]] && grep -q "fit.regions" "$work/bad.txt" && pass "bad [fit] value: error naming fit.regions" || { fail "bad [fit] value"; cat "$work/bad.txt"; }
+  ;;
+resume)
+  "$bin" fit "$work/ph/truth.toml" --out "$work/whole" --no-plots -q >/dev/null 2>&1 || fail "uninterrupted fit"
+  "$bin" fit "$work/ph/truth.toml" --out "$work/parts" --no-plots -q --stop-after 2 >/dev/null 2>&1
+  rc=$?
+  [[ $rc -eq 3 && $(tail -n +2 "$work/parts/history.csv" | wc -l) -eq 2 ]] && pass "--stop-after 2: exit 3, 2 iterations saved" || fail "--stop-after (rc $rc)"
+  "$bin" fit "$work/ph/truth.toml" --out "$work/parts" --no-plots >"$work/parts.txt" 2>&1 || fail "resumed fit"
+  grep -q "^iteration   0" "$work/parts.txt" && fail "resumed fit redid iteration 0" || pass "resumed fit does not redo saved iterations"
+  cmp -s <(cut -d, -f1-7 "$work/whole/history.csv") <(cut -d, -f1-7 "$work/parts/history.csv") && cmp -s "$work/whole/regions.csv" "$work/parts/regions.csv" \
+    && pass "stopped + resumed fit: same history and moduli as uninterrupted" || { fail "stopped + resumed differs"; diff "$work/whole/history.csv" "$work/parts/history.csv"; }
+
+  "$bin" fit "$work/ph/truth.toml" --out "$work/killed" --no-plots -q >/dev/null 2>&1 &
+  pid=$!
+  for _ in $(seq 1 3000); do [[ $(tail -n +2 "$work/killed/history.csv" 2>/dev/null | wc -l) -ge 2 ]] && break; sleep 0.01; done
+  kill -9 "$pid" 2>/dev/null; wait "$pid" 2>/dev/null
+  [[ ! -e "$work/killed/summary.json" ]] && pass "kill -9 during the fit" || echo "     (the fit finished before the kill)"
+  "$bin" fit "$work/ph/truth.toml" --out "$work/killed" --no-plots -q >/dev/null 2>&1 || fail "fit after kill"
+  cmp -s "$work/whole/regions.csv" "$work/killed/regions.csv" && pass "killed + restarted fit: same moduli" || fail "killed + restarted fit differs"
+
+  scene noisy "$linear" truth.nii.gz 'method = "bisection"'
+  printf 'scene,truth\nph/truth.toml,ph/truth.nii.gz\nph/noisy.toml,\nph/truth.toml,ph/truth.nii.gz\n' >"$work/cases.csv"
+  "$bin" fit --cases "$work/cases.csv" --out "$work/serial" --no-plots -q >/dev/null 2>&1 || fail "serial batch"
+  [[ $(grep -c ',ok,' "$work/serial/metrics.csv") -eq 3 ]] && pass "batch: 3 cases ok" || fail "batch cases"
+  "$bin" fit --cases "$work/cases.csv" --out "$work/bkill" --no-plots -q >/dev/null 2>&1 &
+  pid=$!
+  for _ in $(seq 1 6000); do [[ -e "$work/bkill/cases/0001/case.json" && -e "$work/bkill/progress/0002/history.csv" ]] && break; sleep 0.01; done
+  kill -9 "$pid" 2>/dev/null; wait "$pid" 2>/dev/null
+  finished=$(ls "$work/bkill/cases" 2>/dev/null | grep -c '^[0-9]*$')
+  [[ $finished -ge 1 && $finished -lt 3 ]] && pass "kill -9 of the batch after $finished of 3 cases" || fail "batch kill midway ($finished finished)"
+  "$bin" fit --cases "$work/cases.csv" --out "$work/bkill" --no-plots >"$work/bkill.txt" 2>&1 || { fail "batch restart"; cat "$work/bkill.txt"; }
+  grep -q "were finished before this run" "$work/bkill.txt" && pass "restart keeps the finished cases" || fail "restart reran finished cases"
+  cmp -s "$work/serial/metrics.csv" "$work/bkill/metrics.csv" && pass "killed + restarted batch: same metrics.csv" \
+    || { fail "killed batch metrics differ"; diff "$work/serial/metrics.csv" "$work/bkill/metrics.csv" | head; }
+  ;;
+mpi)
+  printf 'scene,truth\nph/truth.toml,ph/truth.nii.gz\nph/truth.toml,\nph/truth.toml,ph/truth.nii.gz\n' >"$work/cases.csv"
+  "$bin" fit --cases "$work/cases.csv" --out "$work/serial" --no-plots -q >/dev/null 2>&1 || fail "serial batch"
+  mpirun=${MPIEXEC:-mpirun}
+  root_flag=$([[ $(id -u) -eq 0 ]] && echo --allow-run-as-root)
+  "$mpirun" $root_flag -n 2 --oversubscribe "$bin" fit --cases "$work/cases.csv" --out "$work/mpi" --no-plots -q >"$work/mpi.txt" 2>&1 \
+    || { fail "mpirun -n 2 batch"; cat "$work/mpi.txt"; }
+  cmp -s "$work/serial/metrics.csv" "$work/mpi/metrics.csv" && pass "mpirun -n 2: same metrics.csv as the serial batch" \
+    || { fail "mpi metrics differ"; diff "$work/serial/metrics.csv" "$work/mpi/metrics.csv" | head; }
+  [[ $(cut -d, -f1,3 "$work/mpi/timing.csv" | grep -c '^000[13],0$') -eq 2 ]] && pass "cases 1 and 3 on rank 0, case 2 on rank 1" || fail "partition"
+  ;;
+*) echo "unknown mode $mode"; exit 2 ;;
+esac
+echo "$passes passed, $failures failed"
+[[ $failures -eq 0 ]]
