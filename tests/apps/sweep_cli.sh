@@ -148,9 +148,10 @@ PY
 device)
   # The device-design sample sweep (docs/POSITIONING.md): stopped after one case, then finished.
   start=$(date +%s)
-  VOXBREAST_BIN=$bin bash "$root/data-samples/phantom/sweep_device.sh" "$work/device" --stop-after 1 -q --no-plots >"$work/device1.txt" 2>&1 \
-    && [[ $(ls "$work/device/cases" | grep -c '^[0-9]*$') -eq 1 ]] && pass "device sweep stopped after 1 case" \
-    || { fail "device sweep --stop-after 1"; cat "$work/device1.txt"; }
+  VOXBREAST_BIN=$bin bash "$root/data-samples/phantom/sweep_device.sh" "$work/device" --stop-after 1 -q --no-plots >"$work/device1.txt" 2>&1
+  rc=$?  # 3: cases left to run
+  [[ $rc -eq 3 && $(ls "$work/device/cases" | grep -c '^[0-9]*$') -eq 1 ]] && pass "device sweep stopped after 1 case (exit 3)" \
+    || { fail "device sweep --stop-after 1 (rc $rc)"; cat "$work/device1.txt"; }
   VOXBREAST_BIN=$bin bash "$root/data-samples/phantom/sweep_device.sh" "$work/device" >"$work/device.txt" 2>&1
   rc=$?
   echo "device sweep: $(( $(date +%s) - start )) s"
