@@ -277,14 +277,9 @@ void Simulator::set_rest_offsets(const std::vector<double>& u0) {
     std::vector<double> prev(6 * n_, 0.0);
     for (std::size_t e = 0; e < n_; ++e)
       for (int c = 0; c < 3; ++c) prev[6 * e + c] = u0[3 * e + c];
-    std::vector<double> pairs = to_lattice_frame(prev);  // 2n vectors: u0_e, 0
-    if (precision_ == Precision::Double) {
-      auto data = pack4<double>(pairs, nullptr);
-      cl_.queue.enqueueWriteBuffer(relax_prev_, CL_TRUE, 0, data.size() * sizeof(double), data.data());
-    } else {
-      auto data = pack4<float>(pairs, nullptr);
-      cl_.queue.enqueueWriteBuffer(relax_prev_, CL_TRUE, 0, data.size() * sizeof(float), data.data());
-    }
+    // 2n vectors (u0_e, 0): write_xyz takes them like any other list of vectors
+    if (precision_ == Precision::Double) write_xyz<double>(relax_prev_, prev, nullptr);
+    else write_xyz<float>(relax_prev_, prev, nullptr);
   }
   if (volume_) {  // the constraint holds the unloaded state's volume
     std::vector<double> rest = element_positions_m(lattice_), unloaded = rest;
