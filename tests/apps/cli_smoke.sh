@@ -5,12 +5,7 @@
 set -uo pipefail
 root=${1:?source dir}
 bin=${VOXBREAST_BIN:?path to voxbreast}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-failures=0
-passes=0
-pass() { passes=$((passes + 1)); echo "ok   $1"; }
-fail() { failures=$((failures + 1)); echo "FAIL $1"; }
+source "$(dirname "$0")/lib.sh"
 
 # --- info
 if "$bin" info >"$work/info.txt" 2>&1 && grep -q "fp64" "$work/info.txt"; then pass "info lists devices"; else fail "info"; cat "$work/info.txt"; fi
@@ -185,5 +180,4 @@ if ! "$bin" probe "$work/noprobe.toml" --out "$work/noprobe" --quiet 2>"$work/no
   pass "probe without [probe]: $(cat "$work/noprobe.err")"
 else fail "probe without [probe]"; cat "$work/noprobe.err"; fi
 
-echo "$passes passed, $failures failed"
-[[ $failures -eq 0 ]]
+finish

@@ -14,12 +14,7 @@ root=${1:?source dir}
 mode=${2:?accuracy, resume or mpi}
 bin=${VOXBREAST_BIN:?path to voxbreast}
 py=$([[ -x /usr/bin/python3 ]] && echo /usr/bin/python3 || echo python3)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-failures=0
-passes=0
-pass() { passes=$((passes + 1)); echo "ok   $1"; }
-fail() { failures=$((failures + 1)); echo "FAIL $1"; }
+source "$(dirname "$0")/lib.sh"
 json() { "$py" -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$1" "$2"; }
 check() {  # name, python condition on the summary d
   if [[ $("$py" -c "import json,sys; d=json.load(open(sys.argv[1])); print(bool($3))" "$2" 2>&1) == True ]]; then pass "$1"
@@ -156,5 +151,4 @@ mpi)
   ;;
 *) echo "unknown mode $mode"; exit 2 ;;
 esac
-echo "$passes passed, $failures failed"
-[[ $failures -eq 0 ]]
+finish

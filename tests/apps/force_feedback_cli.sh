@@ -6,12 +6,7 @@
 set -uo pipefail
 root=${1:?source dir}
 bin=${VOXBREAST_BIN:?path to voxbreast}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-failures=0
-passes=0
-pass() { passes=$((passes + 1)); echo "ok   $1"; }
-fail() { failures=$((failures + 1)); echo "FAIL $1"; }
+source "$(dirname "$0")/lib.sh"
 
 # expect_error NAME PATTERN OUTFILE -- command...: non-zero exit, PATTERN in stderr, OUTFILE absent
 expect_error() {
@@ -69,5 +64,4 @@ expect_error "fit-curve: parameter of another law" "mu is an Ogden parameter" "$
 expect_error "fit-curve: missing curve file" "cannot open" "$work/f6/fit_curve.json" -- \
   "$bin" fit-curve "$cube" --curve "$work/nonexistent.csv" --out "$work/f6"
 
-echo "$passes passed, $failures failed"
-[[ $failures -eq 0 ]]
+finish

@@ -12,12 +12,7 @@ set -uo pipefail
 root=${1:?source dir}
 mode=${2:?resume, mpi or sample}
 bin=${VOXBREAST_BIN:?path to voxbreast}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-failures=0
-passes=0
-pass() { passes=$((passes + 1)); echo "ok   $1"; }
-fail() { failures=$((failures + 1)); echo "FAIL $1"; }
+source "$(dirname "$0")/lib.sh"
 
 cat >"$work/block.toml" <<'TOML'
 # a 5×5×5 block settling on a held base
@@ -49,7 +44,7 @@ same_metrics() {  # name, folder: metrics.csv equals the serial one, byte for by
 }
 
 if ! sweep --out "$work/serial" -q >"$work/serial.txt" 2>&1 || [[ $(grep -c ',ok,' "$work/serial/metrics.csv") -ne 6 ]]; then
-  fail "serial sweep"; cat "$work/serial.txt"; echo "$passes passed, $failures failed"; exit 1
+  fail "serial sweep"; cat "$work/serial.txt"; finish; exit 1
 fi
 pass "serial sweep: 6 cases ok"
 
@@ -172,5 +167,4 @@ PY
 *) echo "unknown mode $mode"; exit 2 ;;
 esac
 
-echo "$passes passed, $failures failed"
-[[ $failures -eq 0 ]]
+finish
