@@ -36,15 +36,6 @@ std::string case_values(const SweepPlan& plan, std::size_t index) {
 }
 
 /// One OpenCL context per worker: every device of --devices, or under MPI the rank's one device.
-std::vector<std::unique_ptr<ClContext>> open_devices(const SweepCommandOptions& o, const MpiWorld& world) {
-  std::vector<DeviceInfo> devices;
-  if (world.size() > 1) devices.push_back(rank_device(o.devices, world.local_rank()));
-  else devices = sweep_devices(o.devices);
-  std::vector<std::unique_ptr<ClContext>> contexts;
-  for (const DeviceInfo& d : devices) contexts.push_back(std::make_unique<ClContext>(d));
-  return contexts;
-}
-
 /// Runs one case of the sweep into its working folder (the same pipeline as `simulate`).
 void run_case(const SweepCase& c, const ClContext& cl, bool full_outputs) {
   const std::string scene_path = c.final_dir + "/scene.toml";
@@ -74,23 +65,14 @@ int run_sweep_command(const SweepCommandOptions& o) {
     return 0;
   }
 
-  std::vector<std::unique_ptr<ClContext>> contexts;
-  std::string device_error;
-  try {
-    contexts = open_devices(o, world);
-  } catch (const std::exception& e) {
-    device_error = e.what();
-  }
-  if (!world.all(device_error.empty()))
-    throw Error(device_error.empty() ? "another MPI rank could not open its device" : device_error, "--devices");
+  const std::vector<std::unique_ptr<ClContext>> contexts = open_worker_contexts(o.devices, world);
 
   SweepOptions options;
   options.out_dir = o.out;
   options.outputs = o.outputs;
   options.stop_after = o.stop_after;
   options.retry_failed = o.retry_failed;
-  options.workers.clear();
-  for (const auto& cl : contexts) options.workers.push_back(std::to_string(cl->info.index) + ": " + cl->info.name);
+  options.workers = worker_names(contexts);
   if (!o.quiet && world.rank() == 0)
     std::printf("sweep: %zu cases, %d rank%s × %zu device%s (%s), outputs %s, into %s\n", plan.grid.size(),
                 world.size(), world.size() == 1 ? "" : "s", contexts.size(), contexts.size() == 1 ? "" : "s",

@@ -119,26 +119,14 @@ int run_fit_batch(const FitBatchOptions& o) {
   plan.grid = SweepGrid({scenes});
 
   MpiWorld world;
-  std::vector<std::unique_ptr<ClContext>> contexts;
-  std::string device_error;
-  try {
-    std::vector<DeviceInfo> devices;
-    if (world.size() > 1) devices.push_back(rank_device(o.devices, world.local_rank()));
-    else devices = sweep_devices(o.devices);
-    for (const DeviceInfo& d : devices) contexts.push_back(std::make_unique<ClContext>(d));
-  } catch (const std::exception& e) {
-    device_error = e.what();
-  }
-  if (!world.all(device_error.empty()))
-    throw Error(device_error.empty() ? "another MPI rank could not open its device" : device_error, "--devices");
+  const std::vector<std::unique_ptr<ClContext>> contexts = open_worker_contexts(o.devices, world);
 
   SweepOptions options;
   options.out_dir = o.out;
   options.outputs = "fit";
   options.stop_after = o.stop_after;
   options.retry_failed = o.retry_failed;
-  options.workers.clear();
-  for (const auto& cl : contexts) options.workers.push_back(std::to_string(cl->info.index) + ": " + cl->info.name);
+  options.workers = worker_names(contexts);
   const std::string rank_tag = world.size() > 1 ? "[rank " + std::to_string(world.rank()) + "] " : "";
   options.on_progress = [&](const SweepProgress& p) {
     if (p.kind != SweepProgress::Kind::Finished || o.quiet) return;

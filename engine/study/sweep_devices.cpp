@@ -34,4 +34,25 @@ DeviceInfo rank_device(const std::string& spec, int local_rank) {
   return devices[std::size_t(local_rank) % devices.size()];
 }
 
+std::vector<std::unique_ptr<ClContext>> open_worker_contexts(const std::string& spec, const MpiWorld& world) {
+  std::vector<std::unique_ptr<ClContext>> contexts;
+  std::string error;
+  try {
+    const std::vector<DeviceInfo> devices =
+        world.size() > 1 ? std::vector<DeviceInfo>{rank_device(spec, world.local_rank())} : sweep_devices(spec);
+    for (const DeviceInfo& d : devices) contexts.push_back(std::make_unique<ClContext>(d));
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  if (!world.all(error.empty()))
+    throw Error(error.empty() ? "another MPI rank could not open its device" : error, "--devices");
+  return contexts;
+}
+
+std::vector<std::string> worker_names(const std::vector<std::unique_ptr<ClContext>>& contexts) {
+  std::vector<std::string> names;
+  for (const auto& cl : contexts) names.push_back(std::to_string(cl->info.index) + ": " + cl->info.name);
+  return names;
+}
+
 }  // namespace vb
