@@ -4,7 +4,7 @@
 # (fit.batch = "auto": all 9 perturbed copies in one simulator; docs/FIT.md "Batched solves").
 #   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
 #   device: bash scripts/gpu_fit.sh        (run tool, carry [".device-pkgs"]; writes $OUT/fit)
-#   local:  OUT=/tmp/gpufit VOXBREAST_BIN=build/apps/voxbreast DEVICE=cpu STOP_AFTER=1 bash scripts/gpu_fit.sh
+#   local:  OUT=/tmp/gpufit VOXBREAST_BIN=build/apps/voxbreast DEVICE=cpu BATCH=9 MAX_ITERATIONS=1 bash scripts/gpu_fit.sh
 # The phantom (3.2 mm voxels, one IDC tumour) is built there; its supine → prone displacement with
 # the material table's moduli is the observation; the fit starts from the HU guess with 8 regions
 # (adipose, fibroglandular and tumour elements in 60 mm blocks: 9 regions, no block size gives
@@ -50,12 +50,12 @@ dvf = "truth.nii.gz"
 regions = "blocks"
 block_mm = 60
 tissues = ["adipose", "fibroglandular", "tumour"]
-max_iterations = 10
+max_iterations = ${MAX_ITERATIONS:-10}
 batch = $3
 TOML
 }
 write_scene "$out/ph/fit_sequential.toml" double 1
-write_scene "$out/ph/fit_batched.toml" double '"auto"'
+write_scene "$out/ph/fit_batched.toml" double "${BATCH:-\"auto\"}"  # auto solves one at a time on a CPU: BATCH=9
 { time vb fit "$out/ph/fit_sequential.toml" --device "$device" --make-observation "$out/ph/truth.nii.gz"; } 2>&1 | tee "$out/timing.txt"
 for b in sequential batched; do
   echo "== fit, double precision, $b perturbed solves" | tee -a "$out/timing.txt"

@@ -38,9 +38,9 @@ class ForwardModel {
   /// tolerance; every copy reports the batch's steps.
   std::vector<ForwardSolution> solve_batch(const std::vector<std::vector<double>>& moduli,
                                            const ForwardSolution* warm = nullptr) const;
-  /// Copies per simulator: fit.batch, or (0, auto) as many as half the device's memory, its
-  /// largest buffer and the 256 tissue ids allow; 1 with [volume] preserve or [reference_state]
-  /// (their constraint and rest state are one per simulator).
+  /// Copies per simulator: fit.batch, or (0, auto) on a GPU as many as half its memory, its
+  /// largest buffer and the 256 tissue ids allow, on a CPU device 1; 1 with [volume] preserve or
+  /// [reference_state] (their constraint and rest state are one per simulator).
   std::size_t batch_size() const;
 
   /// Every element's Young's modulus with these region moduli (n, Pa): the map the fit writes.

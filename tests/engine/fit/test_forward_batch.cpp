@@ -47,13 +47,14 @@ TEST_P(ForwardBatch, EqualsSequentialSolvesToTheEquilibriumTolerance) {
   const Scene s = test::fit_box_scene(test::material("soft", 3000), GetParam().tumour);
   const Lattice lattice = build_lattice(voxelise_shapes(s));
   FitSpec f = test::fit_box_spec();
+  f.batch = 8;  // auto would solve one at a time on a CPU device
   // A tight tolerance, so that what separates batch from alone is far below a Jacobian column's
   // 5% effect: at the default 1e-7 both are equilibria only to ~1e-7 m here (0.4% of a column).
   f.equilibrium = 1e-10;
   const FitRegions regions = make_fit_regions(f, s, lattice);
   ASSERT_EQ(regions.size(), 2u);
   const ForwardModel model(s, lattice, regions, f, test::cl_context());
-  EXPECT_GE(model.batch_size(), 4u);  // auto, on any device with a few MB
+  EXPECT_EQ(model.batch_size(), 8u);
   const std::vector<double> E0 = {3000, 15000};
   const ForwardSolution base = model.solve(E0);
   // The Jacobian's perturbations (±5% in ln E), and a larger step as a trial would take.
@@ -107,13 +108,20 @@ INSTANTIATE_TEST_SUITE_P(Laws, ForwardBatch,
                                            BatchCase{"ogden", ogden_tumour()}),
                          [](const auto& info) { return info.param.name; });
 
-TEST(ForwardBatchSize, OneCopyWithVolumeConstraint) {
+TEST(ForwardBatchSize, AutoFromTheDeviceAndOneWithAVolumeConstraint) {
   Scene s = test::fit_box_scene(test::material("soft", 3000), test::material("tumour", 15000));
-  s.volume.preserve = true;  // one constraint per simulator: copies would share it
   const Lattice lattice = build_lattice(voxelise_shapes(s));
-  const FitSpec f = test::fit_box_spec();
+  FitSpec f = test::fit_box_spec();
   const FitRegions regions = make_fit_regions(f, s, lattice);
-  EXPECT_EQ(ForwardModel(s, lattice, regions, f, test::cl_context()).batch_size(), 1u);
+  const ClContext& cl = test::cl_context();
+  const std::size_t automatic = ForwardModel(s, lattice, regions, f, cl).batch_size();
+  if (cl.info.is_gpu) EXPECT_GE(automatic, 64u);  // a 640-element model: memory is no limit
+  else EXPECT_EQ(automatic, 1u);                  // a CPU gains nothing from batching
+  f.batch = 200;
+  EXPECT_EQ(ForwardModel(s, lattice, regions, f, cl).batch_size(), 200u);  // springs: no tissue-id limit
+  s.volume.preserve = true;  // one constraint per simulator: copies would share it
+  f.batch = 8;
+  EXPECT_EQ(ForwardModel(s, lattice, regions, f, cl).batch_size(), 1u);
 }
 
 }  // namespace
