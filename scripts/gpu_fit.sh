@@ -2,8 +2,10 @@
 # Issue 8's timing: one inverse fit of a ~36k-element phantom with 8 regions on the GPU (goal ≤ 60 s),
 # with the Jacobian's perturbed solves one at a time (fit.batch = 1) and batched on the device
 # (fit.batch = "auto": all 9 perturbed copies in one simulator; docs/FIT.md "Batched solves").
-#   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
+#   here:   cmake --build build --target voxbreast test_physics test_fit && bash scripts/gpu_run.sh prepare
 #   device: bash scripts/gpu_fit.sh        (run tool, carry [".device-pkgs"]; writes $OUT/fit)
+#           First, when the bundle has test_fit: batched = sequential solves on the GPU too
+#           ($OUT/fit/test_fit.txt). SPACING_MM=2.5 for a larger phantom.
 #   local:  OUT=/tmp/gpufit VOXBREAST_BIN=build/apps/voxbreast DEVICE=cpu BATCH=9 MAX_ITERATIONS=1 bash scripts/gpu_fit.sh
 # The phantom (3.2 mm voxels, one IDC tumour) is built there; its supine → prone displacement with
 # the material table's moduli is the observation; the fit starts from the HU guess with 8 regions
@@ -20,6 +22,10 @@ spacing=${SPACING_MM:-3.2}
 mkdir -p "$out"
 if [[ -n "${VOXBREAST_BIN:-}" ]]; then vb() { "$VOXBREAST_BIN" "$@"; }; else vb() { bash scripts/gpu_run.sh run voxbreast "$@"; }; fi
 vb info >"$out/device.txt" 2>&1 || true
+if [[ -z "${VOXBREAST_BIN:-}" ]] && tar -tJf .device-pkgs/bundle.tar.xz bin/test_fit >/dev/null 2>&1; then
+  bash scripts/gpu_run.sh run test_fit --gtest_filter='*Batch*:TiledLattice.*' >"$out/test_fit.txt" 2>&1 || true
+  tail -n 3 "$out/test_fit.txt"
+fi
 vb phantom --out "$out/ph" --spacing "$spacing" --tumour idc,15,-20,5,10 >/dev/null
 write_scene() {  # file, precision, batch
   cat >"$1" <<TOML
