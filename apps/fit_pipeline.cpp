@@ -1,5 +1,6 @@
 #include "apps/fit_pipeline.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <cstdio>
@@ -278,6 +279,8 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
       {"stop_reason", progress.stop_reason},
       {"device", cl.info.name},
       {"precision", scene.solver.precision == Precision::Double ? "double" : "float"},
+      {"batch", std::min(forward.batch_size(), regions.size())},  // copies per batched simulator
+      {"jacobian_wall_time_s", forward.batch_wall_s()},  // this run's perturbed solves (timing.csv, not metrics.csv)
       {"initial", {{"cost", first.cost}, {"rms_mm", first.rms_mm}, {"within_1mm", first.within_1mm}}},
       {"final", {{"cost", last.cost}, {"rms_mm", stats.rms_m * 1e3}, {"mean_mm", stats.mean_m * 1e3},
                  {"p95_mm", stats.p95_m * 1e3}, {"max_mm", stats.max_m * 1e3}, {"within_1mm", stats.within_1mm}}},

@@ -14,7 +14,7 @@ namespace {
 const std::vector<std::string_view> kKeys = {
     "from_posture", "from_gravity", "dvf", "landmarks", "mask", "sigma", "sigma_mm", "regions", "block_mm",
     "tissues", "min_E", "max_E", "initial", "method", "max_iterations", "regularisation", "step_log",
-    "tolerance", "equilibrium", "max_steps"};
+    "tolerance", "equilibrium", "max_steps", "batch"};
 
 class FitTable {
  public:
@@ -150,6 +150,12 @@ FitSpec parse_fit_section(const std::string& scene_text, const std::string& scen
   f.tolerance = t.number("tolerance", 0, false).value_or(f.tolerance);
   f.equilibrium = t.number("equilibrium", 0, true).value_or(f.equilibrium);
   if (const auto n = t.number("max_steps", 1, false)) f.max_steps = std::int64_t(*n);
+  if (const toml::node* n = table->get("batch")) {
+    if (n->is_string() && n->as_string()->get() == "auto") f.batch = 0;
+    else if (!n->is_integer() || n->as_integer()->get() < 0 || n->as_integer()->get() > 256)
+      t.fail("batch", "expected \"auto\" or an integer from 0 (auto) to 256", "batch = 1 solves one copy at a time");
+    else f.batch = int(n->as_integer()->get());
+  }
   return f;
 }
 

@@ -43,6 +43,9 @@ struct FitSpec {
   /// precision, 1e-5 in float (whose rounding floor lies near 1e-6)
   double equilibrium = 0;
   std::int64_t max_steps = 50000;  ///< per forward solve and posture
+  /// model copies one simulator relaxes together for the Jacobian's perturbed solves (docs/FIT.md,
+  /// "Batched solves"); 0: as many as device memory and tissue ids allow; 1: one at a time
+  int batch = 0;
 
   int line = 0;
 };

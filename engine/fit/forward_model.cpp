@@ -5,6 +5,8 @@
 
 #include "engine/error.hpp"
 #include "engine/fit/initial_guess.hpp"
+#include "engine/fit/material_scaling.hpp"
+#include "engine/fit/relax_to_equilibrium.hpp"
 #include "engine/sim/run.hpp"
 #include "engine/sim/simulator.hpp"
 
@@ -73,7 +75,11 @@ ElementArrays ForwardModel::arrays(const std::vector<double>& E) const {
   if (split_) {
     for (std::size_t t = 0; t < split_origin_.size(); ++t) {
       const std::int32_t r = split_origin_[t].first;
-      if (r >= 0) scene_.materials[split_lattice_.tissue_names[t]].youngs_modulus_pa = E[std::size_t(r)];
+      if (r < 0) continue;
+      // hyperelastic laws scale all their constants (docs/FIT.md, "Hyperelastic tissues")
+      MaterialSpec m = material_with_modulus(scene_.materials.at(split_origin_[t].second), E[std::size_t(r)]);
+      m.name = split_lattice_.tissue_names[t];
+      scene_.materials[m.name] = std::move(m);
     }
     return make_element_arrays(scene_, split_lattice_);
   }
@@ -95,31 +101,6 @@ std::vector<double> ForwardModel::element_modulus(const std::vector<double>& E) 
   return out;
 }
 
-namespace {
-
-/// Relaxes the simulator under gravity g to the scene's equilibrium tolerance; returns the steps.
-std::int64_t relax(Simulator& sim, const Scene& scene, const Lattice& lattice, const ElementArrays& el, const Vec3& g,
-                   const char* posture) {
-  sim.set_gravity(g);
-  sim.restart_clock();
-  const double F_ref = equilibrium_scales(lattice, el).first;
-  const std::int64_t every = std::max(1, scene.solver.check_every);
-  for (;;) {
-    sim.advance(every);
-    const StateCheck c = sim.check();
-    require(c.nonfinite_elements == 0 && std::isfinite(c.max_residual_n),
-            "the forward solve went unstable (non-finite state)", std::string("fit, posture ") + posture,
-            "a modulus bound may be too wide: set fit.min_E / fit.max_E");
-    if (c.max_residual_n <= scene.stop.equilibrium * F_ref) return sim.steps();
-    require(sim.steps() < scene.stop.max_steps,
-            "the forward solve did not reach equilibrium in " + std::to_string(scene.stop.max_steps) +
-                " steps (residual " + std::to_string(c.max_residual_n / F_ref) + ")",
-            std::string("fit, posture ") + posture, "raise fit.max_steps or fit.equilibrium");
-  }
-}
-
-}  // namespace
-
 ForwardSolution ForwardModel::solve(const std::vector<double>& E, const ForwardSolution* warm) const {
   const ElementArrays el = arrays(E);
   const Lattice& lat = lattice();
@@ -127,17 +108,18 @@ ForwardSolution ForwardModel::solve(const std::vector<double>& E, const ForwardS
   ++solves_;
   const std::size_t n = lat.element_count();
   const std::vector<double> zeros(3 * n, 0.0);
+  const double F_ref = equilibrium_scales(lat, el).first;
   ForwardSolution out;
   out.from_m = zeros;
   if (fit_.from_gravity_m_s2) {
     if (warm) sim.upload(warm->from_m, zeros);
-    out.steps += relax(sim, scene_, lat, el, *fit_.from_gravity_m_s2, "from");
+    out.steps += relax_to_equilibrium(sim, scene_, F_ref, *fit_.from_gravity_m_s2, "from");
     std::vector<double> v;
     sim.download(out.from_m, v);
   }
   if (warm) sim.upload(warm->to_m, zeros);
   else if (fit_.from_gravity_m_s2) sim.upload(out.from_m, zeros);
-  out.steps += relax(sim, scene_, lat, el, scene_.gravity.acceleration_m_s2, "to");
+  out.steps += relax_to_equilibrium(sim, scene_, F_ref, scene_.gravity.acceleration_m_s2, "to");
   std::vector<double> v;
   sim.download(out.to_m, v);
   return out;

@@ -32,12 +32,25 @@ class ForwardModel {
   /// equilibrium in fit.max_steps.
   ForwardSolution solve(const std::vector<double>& region_modulus_pa, const ForwardSolution* warm = nullptr) const;
 
+  /// Solves several sets of region moduli (each as solve(moduli[k], warm)) with the copies of the
+  /// model side by side in one simulator, batch_size() copies at a time (docs/FIT.md, "Batched
+  /// solves"; engine/fit/forward_batch.cpp). Each result equals its solve() to the equilibrium
+  /// tolerance; every copy reports the batch's steps.
+  std::vector<ForwardSolution> solve_batch(const std::vector<std::vector<double>>& moduli,
+                                           const ForwardSolution* warm = nullptr) const;
+  /// Copies per simulator: fit.batch, or (0, auto) on a GPU as many as half its memory, its
+  /// largest buffer and the 256 tissue ids allow, on a CPU device 1; 1 with [volume] preserve or
+  /// [reference_state] (their constraint and rest state are one per simulator).
+  std::size_t batch_size() const;
+
   /// Every element's Young's modulus with these region moduli (n, Pa): the map the fit writes.
   std::vector<double> element_modulus(const std::vector<double>& region_modulus_pa) const;
 
   const FitRegions& regions() const { return regions_; }
   const Lattice& lattice() const { return split_ ? split_lattice_ : lattice_; }
   std::size_t forward_solves() const { return solves_; }
+  /// wall time spent in solve_batch (the Jacobians' perturbed solves) by this object (s)
+  double batch_wall_s() const { return batch_wall_s_; }
 
  private:
   ElementArrays arrays(const std::vector<double>& region_modulus_pa) const;
@@ -54,6 +67,7 @@ class ForwardModel {
   ElementArrays base_;  ///< element path: the model's arrays
   std::vector<double> base_modulus_;  ///< n: E of each element's own material
   mutable std::size_t solves_ = 0;
+  mutable double batch_wall_s_ = 0;
 };
 
 }  // namespace vb

@@ -101,16 +101,19 @@ FitProgress run_gauss_newton(const FitProblem& p, FitProgress progress, const Fi
   double mu = progress.lm_damping;
   const double alpha = p.spec.regularisation;
   while (int(progress.history.size()) <= p.spec.max_iterations) {
-    // Jacobian of the weighted residual by one-sided perturbed solves in log E.
+    // Jacobian of the weighted residual by one-sided perturbed solves in log E, solved together
+    // (ForwardModel::solve_batch).
     const Eigen::VectorXd r0 = data_residual(*p.observation, base.change_m());
     Eigen::MatrixXd J(r0.size(), Eigen::Index(R));
+    std::vector<std::vector<double>> perturbed(R, E);
+    std::vector<double> h(R);
     for (std::size_t k = 0; k < R; ++k) {
-      std::vector<double> Ek = E;
-      const double h = std::log(E[k]) + p.spec.step_log > hi ? -p.spec.step_log : p.spec.step_log;
-      Ek[k] = E[k] * std::exp(h);
-      const ForwardSolution sk = model.solve(Ek, &base);
-      J.col(Eigen::Index(k)) = (data_residual(*p.observation, sk.change_m()) - r0) / h;
+      h[k] = std::log(E[k]) + p.spec.step_log > hi ? -p.spec.step_log : p.spec.step_log;
+      perturbed[k][k] = E[k] * std::exp(h[k]);
     }
+    const std::vector<ForwardSolution> columns = model.solve_batch(perturbed, &base);
+    for (std::size_t k = 0; k < R; ++k)
+      J.col(Eigen::Index(k)) = (data_residual(*p.observation, columns[k].change_m()) - r0) / h[k];
     Eigen::VectorXd theta(static_cast<Eigen::Index>(R)), theta0(static_cast<Eigen::Index>(R));
     for (std::size_t k = 0; k < R; ++k) theta[Eigen::Index(k)] = std::log(E[k]), theta0[Eigen::Index(k)] = std::log(p.initial_pa[k]);
     const Eigen::MatrixXd H = J.transpose() * J + alpha * Eigen::MatrixXd::Identity(Eigen::Index(R), Eigen::Index(R));

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "engine/error.hpp"
+#include "engine/material/hyperelastic.hpp"
 #include "engine/material/default_materials.hpp"
 
 namespace vb {
@@ -64,10 +65,11 @@ std::vector<double> element_hu(const Lattice& lattice, const ImageVolume& ct) {
 }
 
 double material_modulus_pa(const MaterialSpec& m) {
-  require(m.law == "linear" || m.law == "biphasic" || m.law == "neo-hookean",
-          "a fit scales one Young's modulus per region; the " + m.law + " law of '" + m.name + "' has several constants",
-          "materials." + m.name + ".law", "fit linear, biphasic or neo-hookean tissues (docs/FIT.md)");
-  return m.youngs_modulus_pa;
+  if (m.law == "linear" || m.law == "biphasic" || m.rigid) return m.youngs_modulus_pa;
+  // Hyperelastic: the small-strain E = 9κμ₀/(3κ + μ₀) of the law (for neo-Hookean with κ from ν
+  // this is E itself).
+  if (m.law == "neo-hookean" && m.bulk_modulus_pa <= 0) return m.youngs_modulus_pa;
+  return law_of(m).youngs_modulus_pa();
 }
 
 std::vector<double> moduli_from_materials(const Scene& scene, const Lattice& lattice, const FitRegions& regions) {

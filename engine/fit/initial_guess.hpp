@@ -18,8 +18,9 @@ double modulus_from_hu(double hu, double fat_pa, double gland_pa);
 /// centre falls in takes the CT's value at its centre (nearest voxel).
 std::vector<double> element_hu(const Lattice& lattice, const ImageVolume& ct);
 
-/// Young's modulus a tissue's material gives (Pa): E of linear, biphasic and neo-Hookean laws.
-/// Throws vb::Error for the laws a fit cannot scale by one modulus yet (Mooney-Rivlin, Ogden).
+/// Young's modulus a tissue's material gives (Pa): E of linear and biphasic springs; the
+/// small-strain E = 9κμ₀/(3κ + μ₀) of a hyperelastic law (neo-Hookean, Mooney-Rivlin, Ogden).
+/// Throws vb::Error for impossible hyperelastic constants (law_of).
 double material_modulus_pa(const MaterialSpec& m);
 
 /// Per region: the geometric mean over its elements of the material table's E.

@@ -55,6 +55,16 @@ TEST(FitFile, StrictErrorsNameTheKey) {
   EXPECT_NE(error_of(kObservation + "from_posture = \"sideways\"\n").find("fit.from_posture"), std::string::npos);
 }
 
+TEST(FitFile, BatchIsAutoOrACount) {
+  EXPECT_EQ(parse_fit_section(kObservation, "s.toml").batch, 0);  // auto
+  EXPECT_EQ(parse_fit_section(kObservation + "batch = \"auto\"\n", "s.toml").batch, 0);
+  EXPECT_EQ(parse_fit_section(kObservation + "batch = 1\n", "s.toml").batch, 1);
+  EXPECT_EQ(parse_fit_section(kObservation + "batch = 12\n", "s.toml").batch, 12);
+  EXPECT_NE(error_of(kObservation + "batch = -1\n").find("fit.batch"), std::string::npos);
+  EXPECT_NE(error_of(kObservation + "batch = 2.5\n").find("fit.batch"), std::string::npos);
+  EXPECT_NE(error_of(kObservation + "batch = \"all\"\n").find("fit.batch"), std::string::npos);
+}
+
 TEST(FitInitialGuess, HuRuleIsLogLinearAndClamped) {
   EXPECT_DOUBLE_EQ(modulus_from_hu(kFatHu, 3000, 12000), 3000);
   EXPECT_DOUBLE_EQ(modulus_from_hu(kGlandHu, 3000, 12000), 12000);
