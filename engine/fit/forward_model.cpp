@@ -5,6 +5,7 @@
 
 #include "engine/error.hpp"
 #include "engine/fit/initial_guess.hpp"
+#include "engine/fit/reference_forward.hpp"
 #include "engine/sim/run.hpp"
 #include "engine/sim/simulator.hpp"
 
@@ -31,6 +32,7 @@ ForwardModel::ForwardModel(const Scene& scene, const Lattice& lattice, const Fit
       fit.equilibrium > 0 ? fit.equilibrium : scene.solver.precision == Precision::Double ? 1e-7 : 1e-5;
   scene_.stop.max_steps = fit.max_steps;
   scene_.stop.max_time_s = INFINITY;
+  unloaded_ = use_unloaded_reference(scene, fit);
 
   base_modulus_.resize(lattice.element_count());
   for (std::size_t e = 0; e < base_modulus_.size(); ++e) {
@@ -123,8 +125,9 @@ std::int64_t relax(Simulator& sim, const Scene& scene, const Lattice& lattice, c
 ForwardSolution ForwardModel::solve(const std::vector<double>& E, const ForwardSolution* warm) const {
   const ElementArrays el = arrays(E);
   const Lattice& lat = lattice();
-  Simulator sim(scene_, lat, el, cl_);
   ++solves_;
+  if (unloaded_) return solve_from_unloaded_reference(scene_, lat, el, cl_, warm);
+  Simulator sim(scene_, lat, el, cl_);
   const std::size_t n = lat.element_count();
   const std::vector<double> zeros(3 * n, 0.0);
   ForwardSolution out;

@@ -13,6 +13,9 @@ namespace vb {
 struct ForwardSolution {
   std::vector<double> from_m;  ///< n×3 equilibrium displacement in the `from` posture (m, world); zeros without one
   std::vector<double> to_m;    ///< n×3 equilibrium displacement in the scene's posture (m, world)
+  /// unloaded reference state (fit.unloaded_reference): the rest offsets estimated with these
+  /// moduli (n×3, m); empty otherwise
+  std::vector<double> rest_offset_m;
   std::int64_t steps = 0;      ///< relaxation steps of both postures
   /// the displacement of the posture change: to − from (n×3, m)
   std::vector<double> change_m() const;
@@ -38,6 +41,8 @@ class ForwardModel {
   const FitRegions& regions() const { return regions_; }
   const Lattice& lattice() const { return split_ ? split_lattice_ : lattice_; }
   std::size_t forward_solves() const { return solves_; }
+  /// whether solves start from the unloaded reference state (reference_forward.hpp)
+  bool unloaded_reference() const { return unloaded_; }
 
  private:
   ElementArrays arrays(const std::vector<double>& region_modulus_pa) const;
@@ -48,6 +53,7 @@ class ForwardModel {
   FitSpec fit_;
   const ClContext& cl_;
   bool split_ = false;
+  bool unloaded_ = false;
   Lattice split_lattice_;
   /// split tissue → (region or −1, material name of the original tissue)
   std::vector<std::pair<std::int32_t, std::string>> split_origin_;
