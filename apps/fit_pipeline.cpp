@@ -336,6 +336,8 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
                  {"p95_mm", stats.p95_m * 1e3}, {"max_mm", stats.max_m * 1e3}, {"within_1mm", stats.within_1mm}}},
       {"modulus_pa", regions_json},
   };
+  if (forward.unloaded_reference())  // the fixed point's relaxation solves, all forward solves together
+    summary["reference_state_solves"] = forward.reference_solves();
   if (surface) {
     json per_region = json::object();
     const std::vector<std::size_t> faces = surface->faces_per_region();

@@ -126,7 +126,11 @@ ForwardSolution ForwardModel::solve(const std::vector<double>& E, const ForwardS
   const ElementArrays el = arrays(E);
   const Lattice& lat = lattice();
   ++solves_;
-  if (unloaded_) return solve_from_unloaded_reference(scene_, lat, el, cl_, warm);
+  if (unloaded_) {
+    ForwardSolution out = solve_from_unloaded_reference(scene_, lat, el, cl_, warm);
+    reference_solves_ += std::size_t(out.reference_solves);
+    return out;
+  }
   Simulator sim(scene_, lat, el, cl_);
   const std::size_t n = lat.element_count();
   const std::vector<double> zeros(3 * n, 0.0);

@@ -16,6 +16,7 @@ struct ForwardSolution {
   /// unloaded reference state (fit.unloaded_reference): the rest offsets estimated with these
   /// moduli (n×3, m); empty otherwise
   std::vector<double> rest_offset_m;
+  int reference_solves = 0;    ///< relaxation solves of its fixed point (0 without)
   std::int64_t steps = 0;      ///< relaxation steps of both postures
   /// the displacement of the posture change: to − from (n×3, m)
   std::vector<double> change_m() const;
@@ -43,6 +44,8 @@ class ForwardModel {
   std::size_t forward_solves() const { return solves_; }
   /// whether solves start from the unloaded reference state (reference_forward.hpp)
   bool unloaded_reference() const { return unloaded_; }
+  /// relaxation solves of the unloaded reference state's fixed point, over all forward solves
+  std::size_t reference_solves() const { return reference_solves_; }
 
  private:
   ElementArrays arrays(const std::vector<double>& region_modulus_pa) const;
@@ -60,6 +63,7 @@ class ForwardModel {
   ElementArrays base_;  ///< element path: the model's arrays
   std::vector<double> base_modulus_;  ///< n: E of each element's own material
   mutable std::size_t solves_ = 0;
+  mutable std::size_t reference_solves_ = 0;
 };
 
 }  // namespace vb

@@ -43,6 +43,7 @@ ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice&
   // the fit's residual then includes the estimate's miss, which ref.residual_max_m bounds.
   out.rest_offset_m = ref.rest_offset_m;
   out.steps = ref.steps;
+  out.reference_solves = int(ref.history.size());
   out.from_m.assign(3 * n, 0.0);
 
   Scene to = scene;
