@@ -10,7 +10,8 @@
 namespace vb {
 namespace {
 
-constexpr double kFitReferenceTolerance_m = 1e-7;  // 0.1 µm
+// 0.1 µm in double precision; float rounding (~1e-7 of the model's size) allows about 1 µm
+constexpr double kFitReferenceTolerance_m = 1e-7, kFitReferenceToleranceFloat_m = 1e-6;
 
 }  // namespace
 
@@ -35,7 +36,10 @@ ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice&
   // far more exact than [reference_state] tolerance_mm needs for a simulation, or the fixed
   // point's miss (which depends on where it started) is noise in the Jacobian.
   Scene tight = scene;
-  tight.reference_state.tolerance_m = std::min(scene.reference_state.tolerance_m, kFitReferenceTolerance_m);
+  tight.reference_state.tolerance_m =
+      std::min(scene.reference_state.tolerance_m, scene.solver.precision == Precision::Double
+                                                      ? kFitReferenceTolerance_m
+                                                      : kFitReferenceToleranceFloat_m);
   tight.reference_state.max_iterations = std::max(scene.reference_state.max_iterations, 50);
   const ReferenceState ref =
       estimate_reference_state(tight, lattice, el, cl, warm ? warm->rest_offset_m : std::vector<double>{});

@@ -86,15 +86,20 @@ SignedDistanceField::SignedDistanceField(const ImageVolume& grid, const std::vec
           "check observed_label_values against the label map's values");
   require(in < count, "the region fills the whole observed label map: it has no boundary", what,
           "give a label map whose grid extends past the region");
-  std::vector<std::uint8_t> outside(count);
-  for (std::size_t i = 0; i < count; ++i) outside[i] = !inside[i];
+  // one transform at a time (peak memory: one double per voxel besides the field)
   const Eigen::Vector3d h = grid.spacing_m();
-  const std::vector<double> to_inside = squared_distance_transform(inside, dims_, h);
-  const std::vector<double> to_outside = squared_distance_transform(outside, dims_, h);
   const double half = 0.5 * h.minCoeff();  // the boundary lies on the faces between voxel centres
   phi_m_.resize(count);
+  {
+    const std::vector<double> to_inside = squared_distance_transform(inside, dims_, h);
+    for (std::size_t i = 0; i < count; ++i)
+      if (!inside[i]) phi_m_[i] = float(std::sqrt(to_inside[i]) - half);
+  }
+  std::vector<std::uint8_t> outside(count);
+  for (std::size_t i = 0; i < count; ++i) outside[i] = !inside[i];
+  const std::vector<double> to_outside = squared_distance_transform(outside, dims_, h);
   for (std::size_t i = 0; i < count; ++i)
-    phi_m_[i] = float(inside[i] ? -(std::sqrt(to_outside[i]) - half) : std::sqrt(to_inside[i]) - half);
+    if (inside[i]) phi_m_[i] = float(-(std::sqrt(to_outside[i]) - half));
 }
 
 double SignedDistanceField::at(const Eigen::Vector3d& p) const {
