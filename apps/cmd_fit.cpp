@@ -14,7 +14,8 @@ namespace vb::app {
 namespace {
 
 struct FitCommandOptions {
-  std::string scene, out, device, precision, truth, make_observation, cases, devices;
+  std::string scene, out, device, precision, truth, make_observation, make_labels, cases, devices;
+  int labels_subdivide = 3;
   bool retry_failed = false;
   double noise_mm = 0;
   std::uint64_t seed = 1;
@@ -38,8 +39,15 @@ int run_fit_command(const FitCommandOptions& o) {
   }
   require(!o.scene.empty(), "a scene file (or --cases) is needed", "voxbreast fit", "voxbreast fit SCENE.toml --out DIR");
   const Scene scene = load_scene(o.scene, o.precision);
-  require(!o.out.empty() || !o.make_observation.empty(), "--out is required", "voxbreast fit", "give --out DIR");
+  require(!o.out.empty() || !o.make_observation.empty() || !o.make_labels.empty(), "--out is required", "voxbreast fit",
+          "give --out DIR");
   const ClContext cl(select_device(o.device));
+  if (!o.make_labels.empty()) {
+    const double largest = write_synthetic_labels(scene, cl, o.make_labels, o.labels_subdivide);
+    std::printf("wrote %s: the model's labels after the posture change with the scene's materials (largest %.3f mm)\n",
+                o.make_labels.c_str(), largest * 1e3);
+    if (o.make_observation.empty()) return 0;
+  }
   if (!o.make_observation.empty()) {
     const double largest = write_synthetic_observation(scene, cl, o.make_observation, o.noise_mm * 1e-3, o.seed);
     std::printf("wrote %s: the posture change with the scene's materials (largest %.3f mm), noise %.3g mm\n",
@@ -85,6 +93,12 @@ Command add_fit(CLI::App& app) {
       ->check(CLI::ExistingFile);
   sub->add_option("--make-observation", o->make_observation,
                   "instead of fitting: write the posture change with the scene's materials as a NIfTI DVF (validation)");
+  sub->add_option("--make-observed-labels", o->make_labels,
+                  "instead of fitting: write the model's labels after the posture change with the scene's materials "
+                  "(NIfTI label map, for fit.observed_labels; validation)");
+  sub->add_option("--labels-subdivide", o->labels_subdivide,
+                  "with --make-observed-labels: label voxels per lattice spacing along each axis (default 3)")
+      ->check(CLI::Range(1, 8));
   sub->add_option("--noise-mm", o->noise_mm, "with --make-observation: Gaussian noise per component (mm)")
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--seed", o->seed, "with --make-observation: seed of the noise (default 1)");

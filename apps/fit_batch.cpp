@@ -77,7 +77,7 @@ std::vector<BatchCase> read_cases(const std::string& text, const std::string& pa
 std::string with_absolute_paths(std::string text, const std::string& source) {
   const fs::path base = fs::path(source).parent_path();
   std::vector<std::string> keys = scene_path_keys();
-  for (const char* k : {"fit.dvf", "fit.landmarks", "fit.mask", "fit.sigma"}) keys.push_back(k);
+  for (const char* k : {"fit.dvf", "fit.landmarks", "fit.observed_labels", "fit.mask", "fit.sigma"}) keys.push_back(k);
   for (const std::string& key : keys) {
     const std::string value = scene_string_value(text, source, key);
     if (value.empty() || fs::path(value).is_absolute()) continue;

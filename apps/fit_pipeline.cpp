@@ -1,12 +1,15 @@
 #include "apps/fit_pipeline.hpp"
 
 #include <algorithm>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -15,7 +18,9 @@
 #include "engine/error.hpp"
 #include "engine/fit/forward_model.hpp"
 #include "engine/fit/gauss_newton.hpp"
+#include "engine/fit/deformed_labels.hpp"
 #include "engine/fit/initial_guess.hpp"
+#include "engine/fit/surface_observation.hpp"
 #include "io/atomic_file.hpp"
 #include "io/csv_table.hpp"
 #include "io/fit_file.hpp"
@@ -31,7 +36,7 @@ json progress_to_json(const FitProgress& p) {
   json rows = json::array();
   for (const FitIteration& r : p.history)
     rows.push_back({{"iteration", r.iteration}, {"cost", r.cost}, {"data_cost", r.data_cost}, {"rms_mm", r.rms_mm},
-                    {"within_1mm", r.within_1mm}, {"lm_damping", r.lm_damping},
+                    {"within_1mm", r.within_1mm}, {"max_mm", r.max_mm}, {"lm_damping", r.lm_damping},
                     {"forward_solves", r.forward_solves}, {"wall_time_s", r.wall_time_s},
                     {"modulus_pa", r.modulus_pa}});
   return {{"modulus_pa", p.modulus_pa}, {"lower_log", p.lower_log}, {"upper_log", p.upper_log},
@@ -53,6 +58,7 @@ FitProgress progress_from_json(const json& j) {
     row.data_cost = r.at("data_cost");
     row.rms_mm = r.at("rms_mm");
     row.within_1mm = r.at("within_1mm");
+    row.max_mm = r.value("max_mm", 0.0);
     row.lm_damping = r.at("lm_damping");
     row.forward_solves = r.at("forward_solves");
     row.wall_time_s = r.at("wall_time_s");
@@ -64,7 +70,7 @@ FitProgress progress_from_json(const json& j) {
 
 std::string history_csv(const FitProgress& p, const FitRegions& regions) {
   std::vector<std::string> head = {"iteration", "cost", "data_cost", "rms_mm", "within_1mm", "lm_damping",
-                                   "forward_solves", "wall_time_s"};
+                                   "forward_solves", "wall_time_s", "max_mm"};
   const bool columns = regions.size() <= 64;  // per-region columns only while readable
   if (columns)
     for (const std::string& n : regions.names) head.push_back("E_" + n + "_pa");
@@ -73,7 +79,8 @@ std::string history_csv(const FitProgress& p, const FitRegions& regions) {
     std::vector<std::string> f = {std::to_string(r.iteration), shortest_number_text(r.cost),
                                   shortest_number_text(r.data_cost), shortest_number_text(r.rms_mm),
                                   shortest_number_text(r.within_1mm), shortest_number_text(r.lm_damping),
-                                  std::to_string(r.forward_solves), shortest_number_text(r.wall_time_s)};
+                                  std::to_string(r.forward_solves), shortest_number_text(r.wall_time_s),
+                                  shortest_number_text(r.max_mm)};
     if (columns)
       for (double E : r.modulus_pa) f.push_back(shortest_number_text(E));
     text += csv_line(f);
@@ -104,6 +111,30 @@ Observation load_observation(const FitSpec& fit, const Lattice& lattice) {
   return obs;
 }
 
+/// The label-map observation: boundaries of fit.observed_label_values matched by the model's faces.
+/// An empty lattice voxel counts as air (the body's outside) where the CT there is below −500 HU;
+/// outside the CT (a crop edge) it does not. Shape models: every empty voxel is air.
+std::unique_ptr<SurfaceData> load_surface_observation(const FitSpec& fit, const Scene& scene, const PreparedModel& model) {
+  require(fit.mask_path.empty() && fit.sigma_path.empty(), "fit.mask and fit.sigma apply to displacement observations",
+          "fit.observed_labels", "leave them out; fit.sigma_mm is the surface distance uncertainty");
+  const ImageVolume labels = read_nifti(fit.observed_labels_path);
+  const std::vector<SurfaceRegion> regions = surface_regions(scene, model.lattice, fit.observed_label_values);
+  std::vector<bool> free(model.lattice.element_count());
+  for (std::size_t e = 0; e < free.size(); ++e) free[e] = model.elements.inverse_mass[e] != 0;
+  std::function<bool(const Eigen::Vector3d&)> is_air = [](const Eigen::Vector3d&) { return true; };
+  if (model.ct) {
+    const ImageVolume& ct = *model.ct;
+    const Eigen::Matrix4d to_index = ct.affine_lps_m.inverse();
+    is_air = [&ct, to_index](const Eigen::Vector3d& p) {
+      const Eigen::Vector3d q = (to_index * p.homogeneous()).head<3>();
+      const int i = int(std::lround(q.x())), j = int(std::lround(q.y())), k = int(std::lround(q.z()));
+      if (i < 0 || j < 0 || k < 0 || i >= ct.dims[0] || j >= ct.dims[1] || k >= ct.dims[2]) return false;
+      return ct.values[ct.linear_index(i, j, k)] < -500.0f;
+    };
+  }
+  return std::make_unique<SurfaceData>(labels, model.lattice, regions, free, is_air, fit.sigma_m);
+}
+
 /// The element map on the lattice's own grid (world affine of the lattice), `outside` elsewhere.
 void write_element_map(const std::string& path, const Lattice& lattice, const std::vector<double>& values) {
   ImageVolume image;
@@ -131,20 +162,24 @@ void unobserve_held(Observation& obs, const ElementArrays& elements) {
 /// The warm-start state beside checkpoint.json: raw doubles (from, then to), named by iteration
 /// so the JSON, written after it, always names a complete file.
 void write_state(const std::string& path, const FitProgress& p) {
-  std::string bytes(sizeof(double) * (p.state_from_m.size() + p.state_to_m.size()), '\0');
-  std::memcpy(bytes.data(), p.state_from_m.data(), sizeof(double) * p.state_from_m.size());
-  std::memcpy(bytes.data() + sizeof(double) * p.state_from_m.size(), p.state_to_m.data(),
-              sizeof(double) * p.state_to_m.size());
+  std::string bytes;
+  for (const std::vector<double>* v : {&p.state_from_m, &p.state_to_m, &p.state_rest_m})
+    bytes.append(reinterpret_cast<const char*>(v->data()), sizeof(double) * v->size());
   write_text_atomically(path, bytes);
 }
 
-void read_state(const std::string& path, std::size_t values, FitProgress& p) {
+/// `rest`: the state holds rest offsets too (fit.unloaded_reference)
+void read_state(const std::string& path, std::size_t values, bool rest, FitProgress& p) {
   std::ifstream in(path, std::ios::binary);
-  std::vector<double> all(2 * values);
+  std::vector<double> all((rest ? 3 : 2) * values);
   in.read(reinterpret_cast<char*>(all.data()), std::streamsize(sizeof(double) * all.size()));
   require(bool(in), "the fit's saved state is missing or short", path, "delete the folder to start the fit over");
-  p.state_from_m.assign(all.begin(), all.begin() + std::ptrdiff_t(values));
-  p.state_to_m.assign(all.begin() + std::ptrdiff_t(values), all.end());
+  const auto part = [&](int i) {
+    return std::vector<double>(all.begin() + std::ptrdiff_t(i * values), all.begin() + std::ptrdiff_t((i + 1) * values));
+  };
+  p.state_from_m = part(0);
+  p.state_to_m = part(1);
+  if (rest) p.state_rest_m = part(2);
 }
 
 std::string fingerprint(const Scene& scene) {
@@ -159,13 +194,23 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
   const PreparedModel model = prepare_model(scene);
   const FitRegions regions = make_fit_regions(fit, scene, model.lattice);
   const ForwardModel forward(scene, model.lattice, regions, fit, cl);
-  Observation obs = load_observation(fit, model.lattice);
-  unobserve_held(obs, model.elements);
-  require(obs.observed_elements() > 0, "every observed element is held", "fit");
+  std::optional<Observation> obs;  // displacements, or
+  std::unique_ptr<SurfaceData> surface;  // boundaries of a label map
+  std::unique_ptr<FitData> displacements;
+  if (fit.observed_labels_path.empty()) {
+    obs = load_observation(fit, model.lattice);
+    unobserve_held(*obs, model.elements);
+    require(obs->observed_elements() > 0, "every observed element is held", "fit");
+    displacements = std::make_unique<DisplacementData>(*obs);
+  } else {
+    surface = load_surface_observation(fit, scene, model);
+  }
+  const FitData& data = surface ? static_cast<const FitData&>(*surface) : *displacements;
 
   FitProblem problem;
   problem.model = &forward;
-  problem.observation = &obs;
+  problem.data = &data;
+  problem.observation = obs ? &*obs : nullptr;
   problem.spec = fit;
   std::tie(problem.min_pa, problem.max_pa) = modulus_bounds(fit, scene, model.lattice, regions);
   std::string initial_rule = "materials";
@@ -187,7 +232,7 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
             "use another --out folder or delete it to start over");
     progress = progress_from_json(saved.at("progress"));
     if (const std::string state = saved.value("state", ""); !state.empty())
-      read_state(dir + "/" + state, 3 * forward.lattice().element_count(), progress);
+      read_state(dir + "/" + state, 3 * forward.lattice().element_count(), forward.unloaded_reference(), progress);
   }
   const std::size_t done_before = progress.history.size();
   std::size_t reported = done_before;
@@ -222,6 +267,7 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
   // Finished: the warm-start state is no longer needed.
   progress.state_from_m.clear();
   progress.state_to_m.clear();
+  progress.state_rest_m.clear();
   write_text_atomically(checkpoint_path, json({{"fingerprint", fingerprint(scene)}, {"regions", regions.size()},
                                                {"progress", progress_to_json(progress)}, {"state", ""}})
                                              .dump(1));
@@ -232,7 +278,7 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
   const std::vector<double>& E = progress.history.back().modulus_pa;
   const ForwardSolution final_solution = forward.solve(E);
   const std::vector<double> change = final_solution.change_m();
-  const ResidualStats stats = residual_stats(obs, change);
+  const ResidualStats stats = data.stats(change);
   const std::vector<double> element_E = forward.element_modulus(E);
   write_element_map(dir + "/elasticity.nii.gz", model.lattice, element_E);
   {
@@ -242,11 +288,16 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
     write_nifti_displacement(dir + "/displacement.nii.gz", lattice_grid(model.lattice), field);
   }
   std::vector<double> residual_mm(model.lattice.element_count(), 0.0);
-  for (std::size_t e = 0; e < residual_mm.size(); ++e)
-    if (obs.weight_per_m2[e] > 0)
-      residual_mm[e] = 1e3 * std::hypot(change[3 * e] - obs.displacement_m[3 * e],
-                                        change[3 * e + 1] - obs.displacement_m[3 * e + 1],
-                                        change[3 * e + 2] - obs.displacement_m[3 * e + 2]);
+  if (surface) {  // the largest |surface distance| of each element's faces
+    residual_mm = surface->element_distance(change, model.lattice.element_count());
+    for (double& x : residual_mm) x *= 1e3;
+  } else {
+    for (std::size_t e = 0; e < residual_mm.size(); ++e)
+      if (obs->weight_per_m2[e] > 0)
+        residual_mm[e] = 1e3 * std::hypot(change[3 * e] - obs->displacement_m[3 * e],
+                                          change[3 * e + 1] - obs->displacement_m[3 * e + 1],
+                                          change[3 * e + 2] - obs->displacement_m[3 * e + 2]);
+  }
   write_element_map(dir + "/residual_mm.nii.gz", model.lattice, residual_mm);
 
   std::string regions_text = csv_line({"region", "elements", "initial_E_pa", "fitted_E_pa"});
@@ -270,7 +321,9 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
                        : fit.regions == FitSpec::Regions::Blocks ? "blocks" : "elements"},
       {"regions", regions.size()},
       {"elements", model.lattice.element_count()},
-      {"observed_elements", obs.observed_elements()},
+      {"observation", data.kind()},
+      {"observed_elements", obs ? obs->observed_elements() : 0},
+      {"unloaded_reference", forward.unloaded_reference()},
       {"initial_guess", initial_rule},
       {"bounds_pa", {problem.min_pa, problem.max_pa}},
       {"iterations", int(progress.history.size()) - 1},
@@ -286,12 +339,23 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
                  {"p95_mm", stats.p95_m * 1e3}, {"max_mm", stats.max_m * 1e3}, {"within_1mm", stats.within_1mm}}},
       {"modulus_pa", regions_json},
   };
+  if (forward.unloaded_reference())  // the fixed point's relaxation solves, all forward solves together
+    summary["reference_state_solves"] = forward.reference_solves();
+  if (surface) {
+    json per_region = json::object();
+    const std::vector<std::size_t> faces = surface->faces_per_region();
+    for (std::size_t r = 0; r < faces.size(); ++r) per_region[surface->regions()[r].name] = faces[r];
+    summary["surface"] = {{"path", fit.observed_labels_path}, {"faces", surface->points()}, {"faces_per_region", per_region},
+                          {"initial", {{"rms_mm", first.rms_mm}, {"max_mm", first.max_mm}, {"within_1mm", first.within_1mm}}},
+                          {"final", {{"rms_mm", stats.rms_m * 1e3}, {"mean_mm", stats.mean_m * 1e3}, {"p95_mm", stats.p95_m * 1e3},
+                                     {"max_mm", stats.max_m * 1e3}, {"within_1mm", stats.within_1mm}}}};
+  }
   if (!options.truth_path.empty()) {
     std::vector<float> field;
     const ImageVolume grid = read_nifti_displacement(options.truth_path, field);
     Observation truth = observation_from_field(model.lattice, grid, field, fit.sigma_m);
-    for (std::size_t e = 0; e < truth.weight_per_m2.size(); ++e)
-      if (obs.weight_per_m2[e] == 0) truth.weight_per_m2[e] = 0;  // the same elements as the fit
+    for (std::size_t e = 0; e < truth.weight_per_m2.size(); ++e)  // the fit's elements; surfaces: every free one
+      if (obs ? obs->weight_per_m2[e] == 0 : model.elements.inverse_mass[e] == 0) truth.weight_per_m2[e] = 0;
     const ResidualStats t = residual_stats(truth, change);
     summary["truth"] = {{"path", options.truth_path}, {"elements", t.elements}, {"rms_mm", t.rms_m * 1e3},
                         {"p95_mm", t.p95_m * 1e3}, {"max_mm", t.max_m * 1e3}, {"within_1mm", t.within_1mm}};
@@ -300,6 +364,33 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
   if (options.plots)
     if (const std::string message = draw_fit_plot(dir); !message.empty()) std::fprintf(stderr, "voxbreast: %s\n", message.c_str());
   return summary;
+}
+
+double write_synthetic_labels(const Scene& scene, const ClContext& cl, const std::string& path, int subdivide) {
+  FitSpec fit = parse_fit_section(scene.source_text, scene.source_path);
+  fit.regions = FitSpec::Regions::Labels;
+  fit.tissues.clear();
+  const PreparedModel model = prepare_model(scene);
+  const FitRegions regions = make_fit_regions(fit, scene, model.lattice);
+  const ForwardModel forward(scene, model.lattice, regions, fit, cl);
+  const std::vector<double> change = forward.solve(moduli_from_materials(scene, model.lattice, regions)).change_m();
+  const Lattice& lattice = model.lattice;
+  std::vector<int> value_of_tissue(lattice.tissue_names.size());
+  for (std::size_t t = 0; t < value_of_tissue.size(); ++t) {
+    value_of_tissue[t] = int(t) + 1;  // shape models: the model_labels numbering
+    for (const auto& [v, name] : scene.model.label_table)
+      if (name == lattice.tissue_names[t]) {
+        value_of_tissue[t] = v;  // the first input label value of the tissue
+        break;
+      }
+  }
+  const ImageVolume labels = deformed_label_map(lattice, change, value_of_tissue, subdivide);
+  const int largest_value = *std::max_element(value_of_tissue.begin(), value_of_tissue.end());
+  write_nifti(path, labels, largest_value < 256 ? NiftiType::UInt8 : NiftiType::Int16);
+  double largest = 0;
+  for (std::size_t e = 0; e < lattice.element_count(); ++e)
+    largest = std::max(largest, std::hypot(change[3 * e], change[3 * e + 1], change[3 * e + 2]));
+  return largest;
 }
 
 double write_synthetic_observation(const Scene& scene, const ClContext& cl, const std::string& path, double noise_m,

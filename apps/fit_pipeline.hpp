@@ -34,4 +34,10 @@ nlohmann::json fit_scene(const Scene& scene, const ClContext& cl, const std::str
 double write_synthetic_observation(const Scene& scene, const ClContext& cl, const std::string& path, double noise_m,
                                    std::uint64_t seed);
 
+/// Writes the model's tissues after the scene's posture change with its own materials as a label
+/// map (the observation of a label-map fit's validation, fit.observed_labels): on a grid aligned
+/// with the lattice, `subdivide` voxels per lattice spacing, input label values. Returns the
+/// largest displacement (m).
+double write_synthetic_labels(const Scene& scene, const ClContext& cl, const std::string& path, int subdivide);
+
 }  // namespace vb::app

@@ -14,7 +14,8 @@ namespace {
 const std::vector<std::string_view> kKeys = {
     "from_posture", "from_gravity", "dvf", "landmarks", "mask", "sigma", "sigma_mm", "regions", "block_mm",
     "tissues", "min_E", "max_E", "initial", "method", "max_iterations", "regularisation", "step_log",
-    "tolerance", "equilibrium", "max_steps", "batch"};
+    "tolerance", "equilibrium", "max_steps", "batch", "observed_labels", "observed_label_values",
+    "unloaded_reference"};
 
 class FitTable {
  public:
@@ -86,6 +87,26 @@ class FitTable {
       fail(k, "unknown key", hint.empty() ? "see docs/FIT.md for the [fit] keys" : hint);
     }
   }
+  std::optional<std::vector<int>> integers(const std::string& key, int min) const {
+    const toml::node* n = t_.get(key);
+    if (!n) return std::nullopt;
+    const toml::array* a = n->as_array();
+    if (!a || a->empty()) fail(key, "expected a non-empty array of integers");
+    std::vector<int> out;
+    for (const toml::node& x : *a) {
+      const std::optional<std::int64_t> v = x.value<std::int64_t>();
+      if (!x.is_integer() || !v) fail(key, "expected a non-empty array of integers");
+      if (*v < min || *v > 65535) fail(key, "values must lie in [" + std::to_string(min) + ", 65535]");
+      out.push_back(int(*v));
+    }
+    return out;
+  }
+  std::optional<bool> boolean(const std::string& key) const {
+    const toml::node* n = t_.get(key);
+    if (!n) return std::nullopt;
+    if (!n->is_boolean()) fail(key, "expected true or false");
+    return n->as_boolean()->get();
+  }
   int line() const { return int(t_.source().begin.line); }
 
  private:
@@ -125,8 +146,17 @@ FitSpec parse_fit_section(const std::string& scene_text, const std::string& scen
   f.landmarks_path = resolved(t.text("landmarks").value_or(""), scene_path);
   f.mask_path = resolved(t.text("mask").value_or(""), scene_path);
   f.sigma_path = resolved(t.text("sigma").value_or(""), scene_path);
-  if (f.dvf_path.empty() && f.landmarks_path.empty())
-    t.fail("dvf", "[fit] needs an observation: 'dvf' (NIfTI displacement field) or 'landmarks' (CSV)");
+  f.observed_labels_path = resolved(t.text("observed_labels").value_or(""), scene_path);
+  if (f.dvf_path.empty() && f.landmarks_path.empty() && f.observed_labels_path.empty())
+    t.fail("dvf", "[fit] needs an observation: 'dvf' (NIfTI displacement field), 'landmarks' (CSV) or "
+                  "'observed_labels' (label map of the observed posture)");
+  if (!f.observed_labels_path.empty() && !(f.dvf_path.empty() && f.landmarks_path.empty()))
+    t.fail("observed_labels", "give one kind of observation: displacements ('dvf', 'landmarks') or 'observed_labels'");
+  if (const auto v = t.integers("observed_label_values", 0)) {
+    if (f.observed_labels_path.empty()) t.fail("observed_label_values", "applies only with 'observed_labels'");
+    f.observed_label_values = *v;
+  }
+  f.unloaded_reference = t.boolean("unloaded_reference");
   if (const auto s = t.number("sigma_mm", 0, true)) f.sigma_m = *s * 1e-3;
   using R = FitSpec::Regions;
   f.regions = t.choice<R>("regions", {{"labels", R::Labels}, {"blocks", R::Blocks}, {"elements", R::Elements}})

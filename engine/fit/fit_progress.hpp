@@ -14,6 +14,7 @@ struct FitIteration {
   double data_cost = 0;        ///< mean over observed elements of Σ_xyz ((sim − obs)/σ)²
   double rms_mm = 0;           ///< RMS of |sim − obs| over observed elements (mm)
   double within_1mm = 0;       ///< fraction of observed elements with |sim − obs| ≤ 1 mm
+  double max_mm = 0;           ///< largest |sim − obs| (surface observations: |surface distance|)
   double lm_damping = 0;       ///< Levenberg-Marquardt μ after this iteration (Gauss-Newton)
   std::int64_t forward_solves = 0;  ///< since the start of the fit (all runs)
   double wall_time_s = 0;           ///< since the start of the fit (all runs)
@@ -27,6 +28,7 @@ struct FitProgress {
   /// The forward solution the next iteration starts from (n×3 each, m): saved so a resumed fit
   /// continues exactly as an uninterrupted one would (empty: solve afresh).
   std::vector<double> state_from_m, state_to_m;
+  std::vector<double> state_rest_m;  ///< its rest offsets (fit.unloaded_reference; else empty)
   std::vector<FitIteration> history;
   bool finished = false;
   std::string stop_reason;

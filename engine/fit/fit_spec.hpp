@@ -18,6 +18,10 @@ struct FitSpec {
   // Observation: element displacements from the `from` to the scene's posture.
   std::string dvf_path;        ///< NIfTI displacement field on any grid (sampled at element centres)
   std::string landmarks_path;  ///< CSV: x_mm,y_mm,z_mm,dx_mm,dy_mm,dz_mm[,sigma_mm] (LPS)
+  /// a label map of the observed posture (any grid): its boundaries are matched instead of displacements
+  std::string observed_labels_path;
+  /// which boundaries count: 0 the body outline, v > 0 the region of label v (empty: body + tumours)
+  std::vector<int> observed_label_values;
   std::string mask_path;       ///< NIfTI: elements where it is 0 are not observed
   std::string sigma_path;      ///< NIfTI: per-point displacement uncertainty (mm)
   double sigma_m = 0.001;      ///< uncertainty of an observed displacement component (m)
@@ -46,6 +50,10 @@ struct FitSpec {
   /// model copies one simulator relaxes together for the Jacobian's perturbed solves (docs/FIT.md,
   /// "Batched solves"); 0: as many as device memory and tissue ids allow; 1: one at a time
   int batch = 0;
+
+  /// solve from the unloaded reference state ([reference_state]): rest offsets re-estimated per
+  /// forward solve with the trial moduli. Unset: on exactly when the scene has [reference_state].
+  std::optional<bool> unloaded_reference;
 
   int line = 0;
 };

@@ -61,7 +61,7 @@ std::vector<double> block(const std::vector<double>& state, std::size_t k, std::
 }  // namespace
 
 std::size_t ForwardModel::batch_size() const {
-  if (fit_.batch == 1 || scene_.volume.preserve || scene_.reference_state.active) return 1;
+  if (fit_.batch == 1 || unloaded_ || scene_.volume.preserve || scene_.reference_state.active) return 1;
   const Lattice& lat = lattice();
   const std::size_t n = lat.element_count();
   bool hyper = false;  // as make_element_arrays decides: a tissue table row per copy

@@ -7,6 +7,7 @@
 #include "engine/fit/initial_guess.hpp"
 #include "engine/fit/material_scaling.hpp"
 #include "engine/fit/relax_to_equilibrium.hpp"
+#include "engine/fit/reference_forward.hpp"
 #include "engine/sim/run.hpp"
 #include "engine/sim/simulator.hpp"
 
@@ -33,6 +34,7 @@ ForwardModel::ForwardModel(const Scene& scene, const Lattice& lattice, const Fit
       fit.equilibrium > 0 ? fit.equilibrium : scene.solver.precision == Precision::Double ? 1e-7 : 1e-5;
   scene_.stop.max_steps = fit.max_steps;
   scene_.stop.max_time_s = INFINITY;
+  unloaded_ = use_unloaded_reference(scene, fit);
 
   base_modulus_.resize(lattice.element_count());
   for (std::size_t e = 0; e < base_modulus_.size(); ++e) {
@@ -104,8 +106,13 @@ std::vector<double> ForwardModel::element_modulus(const std::vector<double>& E) 
 ForwardSolution ForwardModel::solve(const std::vector<double>& E, const ForwardSolution* warm) const {
   const ElementArrays el = arrays(E);
   const Lattice& lat = lattice();
-  Simulator sim(scene_, lat, el, cl_);
   ++solves_;
+  if (unloaded_) {
+    ForwardSolution out = solve_from_unloaded_reference(scene_, lat, el, cl_, warm);
+    reference_solves_ += std::size_t(out.reference_solves);
+    return out;
+  }
+  Simulator sim(scene_, lat, el, cl_);
   const std::size_t n = lat.element_count();
   const std::vector<double> zeros(3 * n, 0.0);
   const double F_ref = equilibrium_scales(lat, el).first;

@@ -13,6 +13,10 @@ namespace vb {
 struct ForwardSolution {
   std::vector<double> from_m;  ///< n×3 equilibrium displacement in the `from` posture (m, world); zeros without one
   std::vector<double> to_m;    ///< n×3 equilibrium displacement in the scene's posture (m, world)
+  /// unloaded reference state (fit.unloaded_reference): the rest offsets estimated with these
+  /// moduli (n×3, m); empty otherwise
+  std::vector<double> rest_offset_m;
+  int reference_solves = 0;    ///< relaxation solves of its fixed point (0 without)
   std::int64_t steps = 0;      ///< relaxation steps of both postures
   /// the displacement of the posture change: to − from (n×3, m)
   std::vector<double> change_m() const;
@@ -51,6 +55,10 @@ class ForwardModel {
   std::size_t forward_solves() const { return solves_; }
   /// wall time spent in solve_batch (the Jacobians' perturbed solves) by this object (s)
   double batch_wall_s() const { return batch_wall_s_; }
+  /// whether solves start from the unloaded reference state (reference_forward.hpp)
+  bool unloaded_reference() const { return unloaded_; }
+  /// relaxation solves of the unloaded reference state's fixed point, over all forward solves
+  std::size_t reference_solves() const { return reference_solves_; }
 
  private:
   ElementArrays arrays(const std::vector<double>& region_modulus_pa) const;
@@ -61,6 +69,7 @@ class ForwardModel {
   FitSpec fit_;
   const ClContext& cl_;
   bool split_ = false;
+  bool unloaded_ = false;
   Lattice split_lattice_;
   /// split tissue → (region or −1, material name of the original tissue)
   std::vector<std::pair<std::int32_t, std::string>> split_origin_;
@@ -68,6 +77,7 @@ class ForwardModel {
   std::vector<double> base_modulus_;  ///< n: E of each element's own material
   mutable std::size_t solves_ = 0;
   mutable double batch_wall_s_ = 0;
+  mutable std::size_t reference_solves_ = 0;
 };
 
 }  // namespace vb

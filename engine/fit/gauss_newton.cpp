@@ -30,18 +30,11 @@ struct RunClock {
   }
 };
 
-/// Weighted residual rows sqrt(w/N)·(sim − obs) over observed elements (3 per element).
-Eigen::VectorXd data_residual(const Observation& obs, const std::vector<double>& change_m) {
-  const std::size_t observed = obs.observed_elements();
-  Eigen::VectorXd r(3 * observed);
-  std::size_t row = 0;
-  for (std::size_t e = 0; e < obs.weight_per_m2.size(); ++e) {
-    const double w = obs.weight_per_m2[e];
-    if (w <= 0) continue;
-    const double s = std::sqrt(w / double(observed));
-    for (int a = 0; a < 3; ++a) r[Eigen::Index(row++)] = s * (change_m[3 * e + a] - obs.displacement_m[3 * e + a]);
-  }
-  return r;
+/// Weighted residual rows sqrt(w/N)·(sim − obs) of any kind of observation: N observed points.
+Eigen::VectorXd data_residual(const FitData& data, const std::vector<double>& change_m) {
+  const ResidualRows rows = data.rows(change_m);
+  const double N = double(std::max<std::size_t>(1, data.points()));
+  return (rows.weight_per_m2.array() / N).sqrt() * rows.value_m.array();
 }
 
 double regularisation_cost(const FitProblem& p, const std::vector<double>& E) {
@@ -60,16 +53,18 @@ void finish(FitProgress& progress, const std::string& reason, const FitCheckpoin
 
 FitIteration evaluate_fit(const FitProblem& p, const std::vector<double>& change_m, const std::vector<double>& E) {
   FitIteration row;
-  row.data_cost = data_residual(*p.observation, change_m).squaredNorm();
+  row.data_cost = data_residual(*p.data, change_m).squaredNorm();
   row.cost = row.data_cost + regularisation_cost(p, E);
-  const ResidualStats s = residual_stats(*p.observation, change_m);
+  const ResidualStats s = p.data->stats(change_m);
   row.rms_mm = s.rms_m * 1e3;
   row.within_1mm = s.within_1mm;
+  row.max_mm = s.max_m * 1e3;
   row.modulus_pa = E;
   return row;
 }
 
 FitProgress run_gauss_newton(const FitProblem& p, FitProgress progress, const FitCheckpoint& checkpoint) {
+  require(p.model != nullptr && p.data != nullptr, "a fit needs a forward model and observed data", "fit");
   const ForwardModel& model = *p.model;
   const std::size_t R = p.initial_pa.size();
   require(R <= 512, std::to_string(R) + " regions is too many for a Jacobian by perturbed solves", "fit.regions",
@@ -84,10 +79,12 @@ FitProgress run_gauss_newton(const FitProblem& p, FitProgress progress, const Fi
   } else {  // resumed: the accepted solution of the last iteration
     base.from_m = progress.state_from_m;
     base.to_m = progress.state_to_m;
+    base.rest_offset_m = progress.state_rest_m;
   }
   const auto keep_state = [&] {
     progress.state_from_m = base.from_m;
     progress.state_to_m = base.to_m;
+    progress.state_rest_m = base.rest_offset_m;
   };
   keep_state();
   FitIteration current = evaluate_fit(p, base.change_m(), E);
@@ -103,7 +100,7 @@ FitProgress run_gauss_newton(const FitProblem& p, FitProgress progress, const Fi
   while (int(progress.history.size()) <= p.spec.max_iterations) {
     // Jacobian of the weighted residual by one-sided perturbed solves in log E, solved together
     // (ForwardModel::solve_batch).
-    const Eigen::VectorXd r0 = data_residual(*p.observation, base.change_m());
+    const Eigen::VectorXd r0 = data_residual(*p.data, base.change_m());
     Eigen::MatrixXd J(r0.size(), Eigen::Index(R));
     std::vector<std::vector<double>> perturbed(R, E);
     std::vector<double> h(R);
@@ -113,7 +110,7 @@ FitProgress run_gauss_newton(const FitProblem& p, FitProgress progress, const Fi
     }
     const std::vector<ForwardSolution> columns = model.solve_batch(perturbed, &base);
     for (std::size_t k = 0; k < R; ++k)
-      J.col(Eigen::Index(k)) = (data_residual(*p.observation, columns[k].change_m()) - r0) / h[k];
+      J.col(Eigen::Index(k)) = (data_residual(*p.data, columns[k].change_m()) - r0) / h[k];
     Eigen::VectorXd theta(static_cast<Eigen::Index>(R)), theta0(static_cast<Eigen::Index>(R));
     for (std::size_t k = 0; k < R; ++k) theta[Eigen::Index(k)] = std::log(E[k]), theta0[Eigen::Index(k)] = std::log(p.initial_pa[k]);
     const Eigen::MatrixXd H = J.transpose() * J + alpha * Eigen::MatrixXd::Identity(Eigen::Index(R), Eigen::Index(R));
@@ -171,6 +168,8 @@ FitProgress run_gauss_newton(const FitProblem& p, FitProgress progress, const Fi
 
 FitProgress run_bisection(const FitProblem& p, FitProgress progress, const FitCheckpoint& checkpoint) {
   const ForwardModel& model = *p.model;
+  require(p.observation != nullptr, "the bisection compares displacement magnitudes: it needs a displacement observation",
+          "fit.method", "use method = \"gauss-newton\" with fit.observed_labels");
   const Observation& obs = *p.observation;
   const std::size_t R = p.initial_pa.size();
   const RunClock clock(progress, model);
@@ -183,6 +182,7 @@ FitProgress run_bisection(const FitProblem& p, FitProgress progress, const FitCh
   ForwardSolution last;
   last.from_m = progress.state_from_m;
   last.to_m = progress.state_to_m;
+  last.rest_offset_m = progress.state_rest_m;
   bool have_last = !last.to_m.empty();
   // progress.modulus_pa is always the next state to evaluate; history holds evaluated ones.
   for (;;) {
@@ -220,6 +220,7 @@ FitProgress run_bisection(const FitProblem& p, FitProgress progress, const FitCh
     }
     progress.state_from_m = last.from_m;
     progress.state_to_m = last.to_m;
+    progress.state_rest_m = last.rest_offset_m;
     if (checkpoint) checkpoint(progress);
   }
   progress.modulus_pa = progress.history.back().modulus_pa;

@@ -1,6 +1,7 @@
 #pragma once
 /// Levenberg-Marquardt (damped Gauss-Newton) in log E with Tikhonov regularisation towards the
 /// initial guess, the Jacobian from perturbed forward solves (docs/FIT.md, "Method").
+#include "engine/fit/fit_data.hpp"
 #include "engine/fit/fit_progress.hpp"
 #include "engine/fit/forward_model.hpp"
 #include "engine/fit/observation.hpp"
@@ -9,7 +10,8 @@ namespace vb {
 
 struct FitProblem {
   const ForwardModel* model = nullptr;
-  const Observation* observation = nullptr;
+  const FitData* data = nullptr;            ///< what the cost compares (displacements or surfaces)
+  const Observation* observation = nullptr; ///< displacement observations (the bisection needs them)
   std::vector<double> initial_pa;           ///< per region
   double min_pa = 0, max_pa = 0;            ///< bounds
   FitSpec spec;

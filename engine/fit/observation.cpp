@@ -113,6 +113,10 @@ ResidualStats residual_stats(const Observation& obs, const std::vector<double>& 
     d.push_back(std::hypot(sim[3 * e] - obs.displacement_m[3 * e], sim[3 * e + 1] - obs.displacement_m[3 * e + 1],
                            sim[3 * e + 2] - obs.displacement_m[3 * e + 2]));
   }
+  return distance_stats(std::move(d));
+}
+
+ResidualStats distance_stats(std::vector<double> d) {
   ResidualStats s;
   s.elements = d.size();
   if (d.empty()) return s;

@@ -42,5 +42,7 @@ struct ResidualStats {
   double within_1mm = 0;  ///< fraction of elements with |simulated − observed| ≤ 1 mm
 };
 ResidualStats residual_stats(const Observation& obs, const std::vector<double>& simulated_m);
+/// The same statistics of per-point distances (m), e.g. surface distances.
+ResidualStats distance_stats(std::vector<double> distances_m);
 
 }  // namespace vb

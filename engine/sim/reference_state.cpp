@@ -51,10 +51,16 @@ Scene reference_state_scene(const Scene& scene) {
 
 ReferenceState estimate_reference_state(const Scene& scene, const Lattice& lattice, const ClContext& cl,
                                         const std::function<void(const ReferenceIteration&)>& on_iteration) {
+  return estimate_reference_state(scene, lattice, make_element_arrays(reference_state_scene(scene), lattice), cl, {},
+                                  on_iteration);
+}
+
+ReferenceState estimate_reference_state(const Scene& scene, const Lattice& lattice, const ElementArrays& el,
+                                        const ClContext& cl, const std::vector<double>& first_offset_m,
+                                        const std::function<void(const ReferenceIteration&)>& on_iteration) {
   ReferenceState out;
   const auto start = std::chrono::steady_clock::now();
   const Scene ct = reference_state_scene(scene);
-  const ElementArrays el = make_element_arrays(ct, lattice);
   Simulator sim(ct, lattice, el, cl);
   const std::size_t n = lattice.element_count();
   // The residual is measured over the free elements that can rest at their CT position. The
@@ -73,7 +79,7 @@ ReferenceState estimate_reference_state(const Scene& scene, const Lattice& latti
       for (const std::int32_t j : lattice.neighbours(e))
         if (j >= 0 && measured[std::size_t(j)]) follows[e].push_back(std::size_t(j));
 
-  out.rest_offset_m.assign(3 * n, 0.0);
+  out.rest_offset_m = first_offset_m.size() == 3 * n ? first_offset_m : std::vector<double>(3 * n, 0.0);
   const std::vector<double> at_rest(3 * n, 0.0);
   // One forward solve from the CT with rest offsets u0: where the model lands (u*), or nothing
   // when the solve goes unstable (rest offsets too far from any sensible shape).

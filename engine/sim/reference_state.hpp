@@ -49,4 +49,12 @@ Scene reference_state_scene(const Scene& scene);
 ReferenceState estimate_reference_state(const Scene& scene, const Lattice& lattice, const ClContext& cl,
                                         const std::function<void(const ReferenceIteration&)>& on_iteration = {});
 
+/// The same with the caller's element arrays (e.g. a fit's trial moduli; built for this scene and
+/// lattice) and a first estimate of the rest offsets (n×3; empty: zero, the CT as rest shape). A
+/// first estimate close to the answer (the previous moduli's) lands within tolerance in fewer
+/// forward solves.
+ReferenceState estimate_reference_state(const Scene& scene, const Lattice& lattice, const ElementArrays& elements,
+                                        const ClContext& cl, const std::vector<double>& first_offset_m,
+                                        const std::function<void(const ReferenceIteration&)>& on_iteration = {});
+
 }  // namespace vb

@@ -8,16 +8,22 @@
 #              history and moduli as an uninterrupted one; a killed batch resumes and writes the
 #              same metrics.csv as an uninterrupted batch
 #   mpi      — a 2-rank `mpirun` batch writes the same metrics.csv as the serial batch
+#   labels   — the observation is a label map of the observed posture (surface distances): from
+#              wrong moduli the fit moves adipose and fibroglandular tissue towards the truth and
+#              reduces the surface distance and the displacement error
+#   reference — the scene has [reference_state]: a fit solving from the unloaded reference state
+#              recovers the moduli of an observation simulated with it better than one without,
+#              and resumes exactly
 #   VOXBREAST_BIN=build/apps/voxbreast VOXBREAST_DEVICE=cpu bash tests/apps/fit_cli.sh . accuracy
 set -uo pipefail
 root=${1:?source dir}
-mode=${2:?accuracy, resume or mpi}
+mode=${2:?accuracy, resume, mpi, labels or reference}
 bin=${VOXBREAST_BIN:?path to voxbreast}
 py=$([[ -x /usr/bin/python3 ]] && echo /usr/bin/python3 || echo python3)
 source "$(dirname "$0")/lib.sh"
-json() { "$py" -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$1" "$2"; }
+json() { "$py" -c "import json,math,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$1" "$2"; }
 check() {  # name, python condition on the summary d
-  if [[ $("$py" -c "import json,sys; d=json.load(open(sys.argv[1])); print(bool($3))" "$2" 2>&1) == True ]]; then pass "$1"
+  if [[ $("$py" -c "import json,math,sys; d=json.load(open(sys.argv[1])); print(bool($3))" "$2" 2>&1) == True ]]; then pass "$1"
   else fail "$1"; head -c 1500 "$2"; fi
 }
 
@@ -148,6 +154,70 @@ mpi)
   cmp -s "$work/serial/metrics.csv" "$work/mpi/metrics.csv" && pass "mpirun -n 2: same metrics.csv as the serial batch" \
     || { fail "mpi metrics differ"; diff "$work/serial/metrics.csv" "$work/mpi/metrics.csv" | head; }
   [[ $(cut -d, -f1,3 "$work/mpi/timing.csv" | grep -c '^000[13],0$') -eq 2 ]] && pass "cases 1 and 3 on rank 0, case 2 on rank 1" || fail "partition"
+  ;;
+labels)
+  "$bin" fit "$work/ph/truth.toml" --make-observed-labels "$work/ph/obs_labels.nii.gz" --labels-subdivide 6 >/dev/null \
+    || fail "--make-observed-labels"
+  # the fit starts from wrong moduli (its scene's material table): 1.8, 11 and 6 kPa
+  wrong='[materials.adipose]
+E = 1800.0
+[materials.fibroglandular]
+E = 11000.0
+[materials.tumour]
+E = 6000.0'
+  scene lab "$wrong" truth.nii.gz 'initial = "materials"'
+  sed -i 's/^dvf = .*/observed_labels = "obs_labels.nii.gz"/' "$work/ph/lab.toml"
+  "$bin" fit "$work/ph/lab.toml" --out "$work/lab" --truth "$work/ph/truth.nii.gz" --no-plots -q >"$work/lab.txt" 2>&1 \
+    || { fail "label-map fit"; cat "$work/lab.txt"; }
+  sed 's/^initial = .*/&\nmax_iterations = 0/' "$work/ph/lab.toml" >"$work/ph/lab0.toml"
+  "$bin" fit "$work/ph/lab0.toml" --out "$work/lab0" --truth "$work/ph/truth.nii.gz" --no-plots -q >/dev/null 2>&1 || fail "initial guess"
+  s="$work/lab/summary.json"
+  echo "     adipose $(json "$s" "round(d['modulus_pa']['adipose']['fitted_E_pa'])") Pa (from 1800, truth 3250), fibroglandular $(json "$s" "round(d['modulus_pa']['fibroglandular']['fitted_E_pa'])") (from 11000, truth 6000), tumour $(json "$s" "round(d['modulus_pa']['tumour']['fitted_E_pa'])") (from 6000, truth 16400)"
+  echo "     surface RMS $(json "$s" "round(d['surface']['initial']['rms_mm'], 4)") -> $(json "$s" "round(d['surface']['final']['rms_mm'], 4)") mm, max $(json "$s" "round(d['surface']['final']['max_mm'], 3)") mm, within 1 mm $(json "$s" "d['surface']['final']['within_1mm']"); truth RMS $(json "$work/lab0/summary.json" "round(d['truth']['rms_mm'], 4)") -> $(json "$s" "round(d['truth']['rms_mm'], 4)") mm; $(json "$s" "d['forward_solves']") forward solves"
+  check "label map: body and tumour boundaries observed" "$s" \
+    "d['observation'] == 'surface' and d['surface']['faces_per_region']['body'] > 1000 and d['surface']['faces_per_region']['tumour'] > 0"
+  check "label map: adipose and fibroglandular moduli at least halve their log error" "$s" \
+    "all(abs(math.log(d['modulus_pa'][t]['fitted_E_pa'] / T)) <= 0.5 * abs(math.log(d['modulus_pa'][t]['initial_E_pa'] / T)) for t, T in (('adipose', 3250), ('fibroglandular', 6000)))"
+  check "label map: surface distance falls (RMS, within 1 mm >= 99%)" "$s" \
+    "d['surface']['final']['rms_mm'] < d['surface']['initial']['rms_mm'] and d['surface']['final']['within_1mm'] >= 0.99"
+  truth0=$(json "$work/lab0/summary.json" "d['truth']['rms_mm']")
+  check "label map: displacement error against the truth falls" "$s" "d['truth']['rms_mm'] < 0.5 * $truth0"
+  head -1 "$work/lab/history.csv" | grep -q max_mm && pass "history.csv has max_mm" || fail "history.csv max_mm"
+  sed 's/^initial = .*/&\nmethod = "bisection"/' "$work/ph/lab.toml" >"$work/ph/labbis.toml"
+  "$bin" fit "$work/ph/labbis.toml" --out "$work/labbis" >"$work/labbis.txt" 2>&1
+  [[ $? -ne 0 ]] && grep -q "fit.method" "$work/labbis.txt" && pass "bisection with a label map: error naming fit.method" || { fail "bisection with a label map"; cat "$work/labbis.txt"; }
+  sed 's/^initial = .*/&\nobserved_label_values = [0, 9]/' "$work/ph/lab.toml" >"$work/ph/labbad.toml"
+  "$bin" fit "$work/ph/labbad.toml" --out "$work/labbad" >"$work/labbad.txt" 2>&1
+  [[ $? -ne 0 ]] && grep -q "label value 9" "$work/labbad.txt" && pass "unknown label value: error" || { fail "unknown label value"; cat "$work/labbad.txt"; }
+  ;;
+reference)
+  # the CT (the phantom) was taken supine: the observation is simulated from the unloaded state
+  scene ref "$linear" ref_truth.nii.gz ""
+  sed -i -e '/^from_posture = /d' -e 's/^\[fit\]/[reference_state]\nct_posture = "supine"\n[fit]/' "$work/ph/ref.toml"
+  "$bin" fit "$work/ph/ref.toml" --make-observation "$work/ph/ref_truth.nii.gz" >/dev/null || fail "--make-observation with [reference_state]"
+  "$bin" fit "$work/ph/ref.toml" --out "$work/on" --truth "$work/ph/ref_truth.nii.gz" --no-plots -q >"$work/on.txt" 2>&1 || { fail "fit from the unloaded state"; cat "$work/on.txt"; }
+  (cat "$work/ph/ref.toml"; printf 'unloaded_reference = false\nfrom_posture = "supine"\n') >"$work/ph/refoff.toml"
+  "$bin" fit "$work/ph/refoff.toml" --out "$work/off" --truth "$work/ph/ref_truth.nii.gz" --no-plots -q >/dev/null 2>&1 || fail "fit with the CT as rest shape"
+  for d in on off; do
+    echo "     $d: adipose $(json "$work/$d/summary.json" "round(d['modulus_pa']['adipose']['fitted_E_pa'])") (3250), fibroglandular $(json "$work/$d/summary.json" "round(d['modulus_pa']['fibroglandular']['fitted_E_pa'])") (6000), tumour $(json "$work/$d/summary.json" "round(d['modulus_pa']['tumour']['fitted_E_pa'])") (16400); truth RMS $(json "$work/$d/summary.json" "round(d['truth']['rms_mm'], 5)") mm; $(json "$work/$d/summary.json" "d['forward_solves']") forward solves, $(json "$work/$d/summary.json" "round(d['wall_time_s'], 1)") s"
+  done
+  err='max(abs(math.log(d["modulus_pa"][t]["fitted_E_pa"] / T)) for t, T in (("adipose", 3250), ("fibroglandular", 6000), ("tumour", 16400)))'
+  check "unloaded reference: on by default with [reference_state], every modulus within 2%" "$work/on/summary.json" \
+    "d['unloaded_reference'] and $err <= 0.02"
+  off_err=$(json "$work/off/summary.json" "$err")
+  off_rms=$(json "$work/off/summary.json" "d['truth']['rms_mm']")
+  check "unloaded reference: moduli and displacements closer to the truth than with the CT as rest shape" "$work/on/summary.json" \
+    "$err <= $off_err and d['truth']['rms_mm'] <= $off_rms"
+  "$bin" fit "$work/ph/ref.toml" --out "$work/parts" --no-plots -q --stop-after 2 >/dev/null 2>&1
+  "$bin" fit "$work/ph/ref.toml" --out "$work/parts" --no-plots -q >/dev/null 2>&1 || fail "resumed fit from the unloaded state"
+  cmp -s "$work/on/regions.csv" "$work/parts/regions.csv" && cmp -s <(cut -d, -f1-7 "$work/on/history.csv") <(cut -d, -f1-7 "$work/parts/history.csv") \
+    && pass "unloaded reference: stopped + resumed fit repeats the uninterrupted one" || { fail "resume from the unloaded state differs"; diff "$work/on/history.csv" "$work/parts/history.csv"; }
+  sed 's/^tissues = .*/&\nfrom_posture = "upright"/' "$work/ph/ref.toml" >"$work/ph/refbad.toml"
+  "$bin" fit "$work/ph/refbad.toml" --out "$work/refbad" >"$work/refbad.txt" 2>&1
+  [[ $? -ne 0 ]] && grep -q "fit.from_posture" "$work/refbad.txt" && pass "from_posture other than the CT's: error" || { fail "from_posture mismatch"; cat "$work/refbad.txt"; }
+  sed 's/^tissues = .*/&\nunloaded_reference = true/' "$work/ph/truth.toml" >"$work/ph/refnone.toml"
+  "$bin" fit "$work/ph/refnone.toml" --out "$work/refnone" >"$work/refnone.txt" 2>&1
+  [[ $? -ne 0 ]] && grep -q "reference_state" "$work/refnone.txt" && pass "unloaded_reference without [reference_state]: error" || { fail "unloaded_reference without [reference_state]"; cat "$work/refnone.txt"; }
   ;;
 *) echo "unknown mode $mode"; exit 2 ;;
 esac

@@ -65,6 +65,21 @@ TEST(FitFile, BatchIsAutoOrACount) {
   EXPECT_NE(error_of(kObservation + "batch = \"all\"\n").find("fit.batch"), std::string::npos);
 }
 
+TEST(FitFile, LabelMapObservationAndUnloadedReference) {
+  const std::string labels = "[gravity]\nposture = \"prone\"\n[fit]\nobserved_labels = \"prone_labels.nii.gz\"\n";
+  const FitSpec f = parse_fit_section(labels + "observed_label_values = [0, 6]\nunloaded_reference = false\n",
+                                      "/data/case/scene.toml");
+  EXPECT_EQ(f.observed_labels_path, "/data/case/prone_labels.nii.gz");
+  EXPECT_EQ(f.observed_label_values, (std::vector<int>{0, 6}));
+  ASSERT_TRUE(f.unloaded_reference.has_value());
+  EXPECT_FALSE(*f.unloaded_reference);
+  EXPECT_FALSE(parse_fit_section(labels, "/s.toml").unloaded_reference.has_value());  // unset: follows the scene
+  EXPECT_NE(error_of(labels + "dvf = \"obs.nii.gz\"\n").find("one kind of observation"), std::string::npos);
+  EXPECT_NE(error_of(kObservation + "observed_label_values = [6]\n").find("only with 'observed_labels'"), std::string::npos);
+  EXPECT_NE(error_of(labels + "observed_label_values = [-1]\n").find("fit.observed_label_values"), std::string::npos);
+  EXPECT_NE(error_of(labels + "unloaded_reference = 1\n").find("true or false"), std::string::npos);
+}
+
 TEST(FitInitialGuess, HuRuleIsLogLinearAndClamped) {
   EXPECT_DOUBLE_EQ(modulus_from_hu(kFatHu, 3000, 12000), 3000);
   EXPECT_DOUBLE_EQ(modulus_from_hu(kGlandHu, 3000, 12000), 12000);

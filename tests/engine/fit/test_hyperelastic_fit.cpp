@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "engine/fit/fit_data.hpp"
 #include "engine/fit/gauss_newton.hpp"
 #include "engine/fit/initial_guess.hpp"
 #include "engine/fit/material_scaling.hpp"
@@ -84,8 +85,10 @@ TEST_P(HyperelasticFit, RecoversTheInclusionsModulus) {
   obs.weight_per_m2.resize(lattice.element_count());
   for (std::size_t e = 0; e < lattice.element_count(); ++e) obs.weight_per_m2[e] = el.inverse_mass[e] > 0 ? 1e6 : 0;
 
+  const DisplacementData data(obs);
   FitProblem p;
   p.model = &model;
+  p.data = &data;
   p.observation = &obs;
   p.initial_pa = {0.7 * truth[0], 0.4 * truth[1]};  // 30% too soft, the inclusion 2.5× too soft
   p.min_pa = 500;

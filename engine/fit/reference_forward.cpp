@@ -1,0 +1,70 @@
+#include "engine/fit/reference_forward.hpp"
+
+#include <algorithm>
+
+#include "engine/error.hpp"
+#include "engine/sim/reference_state.hpp"
+#include "engine/sim/run.hpp"
+#include "engine/sim/simulator.hpp"
+
+namespace vb {
+namespace {
+
+// 0.1 µm in double precision; float rounding (~1e-7 of the model's size) allows about 1 µm
+constexpr double kFitReferenceTolerance_m = 1e-7, kFitReferenceToleranceFloat_m = 1e-6;
+
+}  // namespace
+
+bool use_unloaded_reference(const Scene& scene, const FitSpec& fit) {
+  const bool on = fit.unloaded_reference.value_or(scene.reference_state.active);
+  if (!on) return false;
+  require(scene.reference_state.active, "fit.unloaded_reference needs the scene's [reference_state]", "fit.unloaded_reference",
+          "add [reference_state] ct_posture = \"...\" (the posture of the model's image), or remove the key");
+  if (fit.from_gravity_m_s2)
+    require((*fit.from_gravity_m_s2 - scene.reference_state.ct_gravity_m_s2).norm() <= 1e-9 * (1 + fit.from_gravity_m_s2->norm()),
+            "fit.from_posture differs from [reference_state]'s CT posture", "fit.from_posture",
+            "with the unloaded reference state the image posture is [reference_state] ct_posture: leave "
+            "fit.from_posture out, or set fit.unloaded_reference = false");
+  return true;
+}
+
+ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice& lattice, const ElementArrays& el,
+                                              const ClContext& cl, const ForwardSolution* warm) {
+  const std::size_t n = lattice.element_count();
+  ForwardSolution out;
+  // The fit differences solves whose moduli differ by a few percent: the rest offsets must be
+  // far more exact than [reference_state] tolerance_mm needs for a simulation, or the fixed
+  // point's miss (which depends on where it started) is noise in the Jacobian.
+  Scene tight = scene;
+  tight.reference_state.tolerance_m =
+      std::min(scene.reference_state.tolerance_m, scene.solver.precision == Precision::Double
+                                                      ? kFitReferenceTolerance_m
+                                                      : kFitReferenceToleranceFloat_m);
+  tight.reference_state.max_iterations = std::max(scene.reference_state.max_iterations, 50);
+  const ReferenceState ref =
+      estimate_reference_state(tight, lattice, el, cl, warm ? warm->rest_offset_m : std::vector<double>{});
+  // Not within tolerance after max_iterations: the best estimate is kept (as `simulate` does);
+  // the fit's residual then includes the estimate's miss, which ref.residual_max_m bounds.
+  out.rest_offset_m = ref.rest_offset_m;
+  out.steps = ref.steps;
+  out.reference_solves = int(ref.history.size());
+  out.from_m.assign(3 * n, 0.0);
+
+  Scene to = scene;
+  to.output.frames_every = 0;
+  Simulator sim(to, lattice, el, cl);
+  sim.set_rest_offsets(ref.rest_offset_m);
+  const std::vector<double> still(3 * n, 0.0);
+  sim.upload(warm ? warm->to_m : el.displacement_m, still);
+  sim.restart_clock();
+  const RunOutput run = run_simulation(to, lattice, el, sim);
+  require(run.summary.converged,
+          "the forward solve from the unloaded reference state stopped at " + run.summary.stop_reason + " after " +
+              std::to_string(run.summary.steps) + " steps without reaching equilibrium",
+          "fit, posture to", "raise fit.max_steps or fit.equilibrium");
+  out.to_m = run.state.displacement_m;
+  out.steps += run.summary.steps;
+  return out;
+}
+
+}  // namespace vb
