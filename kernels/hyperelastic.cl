@@ -85,6 +85,21 @@ inline real4 mat3_apply(mat3 a, real4 v) {
                  a.m[2][0] * v.x + a.m[2][1] * v.y + a.m[2][2] * v.z, 0);
 }
 
+// M·(h·d) for lattice direction d, skipping d's zero components: d is a constant once the
+// neighbour loop is unrolled, and IEEE rules forbid the compiler to drop x·0 itself (a face
+// direction takes 3 multiply-adds instead of 9). The same value as mat3_apply(M, h·d).
+inline real4 mat3_apply_dir(mat3 a, int d, real h) {
+  real4 r = (real4)(0);
+  for (int b = 0; b < 3; ++b) {
+    if (VB_DIR[d][b] == 0) continue;
+    const real hb = h * VB_DIR[d][b];
+    r.x += a.m[0][b] * hb;
+    r.y += a.m[1][b] * hb;
+    r.z += a.m[2][b] * hb;
+  }
+  return r;
+}
+
 inline void mat3_store(global real4* rows, uint e, mat3 a) {
   for (int i = 0; i < 3; ++i) rows[3 * e + i] = (real4)(a.m[i][0], a.m[i][1], a.m[i][2], 0);
 }
@@ -230,6 +245,7 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
   const real4 ue = u[e];
   mat3 A = mat3_zero(), B = mat3_zero();  // B in units of h²
   uint present = 0;
+#pragma unroll
   for (int d = 0; d < 26; ++d) {
     const int j = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
     if (j < 0) continue;
@@ -237,11 +253,15 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
     const real4 uj = u[j];
     const real dX[3] = {VB_DIR[d][0], VB_DIR[d][1], VB_DIR[d][2]};
     const real dx[3] = {h * dX[0] + (uj.x - ue.x), h * dX[1] + (uj.y - ue.y), h * dX[2] + (uj.z - ue.z)};
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
+    // only d's nonzero components (constants once unrolled): adding x·0 changes nothing, but the
+    // compiler may not drop it under IEEE rules
+    for (int b = 0; b < 3; ++b) {
+      if (VB_DIR[d][b] == 0) continue;
+      for (int a = 0; a < 3; ++a) {
         A.m[a][b] += dx[a] * dX[b];  // in units of h (dX dimensionless)
         B.m[a][b] += dX[a] * dX[b];
       }
+    }
   }
   *present_out = present;
   const real detB = mat3_det(B);

@@ -92,11 +92,16 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
     const int law_j = (int)mat_j[0];
 #endif
 #if VB_HYPER
+#if VB_REST_OFFSET
+#define VB_APPLY_R0(M) mat3_apply(M, r0)
+#else
+#define VB_APPLY_R0(M) mat3_apply_dir(M, d, h)  // r0 = h·d
+#endif
     real magnitude = !VB_LAW_HYPER(law_i) ? spring_end(law_i, mat_i, k, len, rest)
-                                          : hourglass * k * (len - norm3(mat3_apply(Fi, r0)));
+                                          : hourglass * k * (len - norm3(VB_APPLY_R0(Fi)));
     magnitude += !VB_LAW_HYPER(law_j) ? spring_end(law_j, mat_j, k, len, rest)
-                                      : hourglass * k * (len - norm3(mat3_apply(mat3_load(Fs, (uint)j), r0)));
-    if (VB_LAW_HYPER(law_j)) f += present * mat3_apply(mat3_load(Qs, (uint)j), hd);
+                                      : hourglass * k * (len - norm3(VB_APPLY_R0(mat3_load(Fs, (uint)j))));
+    if (VB_LAW_HYPER(law_j)) f += present * mat3_apply_dir(mat3_load(Qs, (uint)j), d, h);
     own_offsets += present * hd;
 #elif VB_BIPHASIC
     real magnitude = spring_end(law_i, mat_i, k, len, rest) + spring_end(law_j, mat_j, k, len, rest);
