@@ -18,6 +18,7 @@ struct BenchCase {
   Integrator integrator = Integrator::Heun;
   Precision precision = Precision::Float;
   std::string law = "linear";
+  bool volume = false;
 };
 
 /// A cube of `edge`³ adipose elements, base held, under gravity: the standard linear block.
@@ -56,6 +57,7 @@ Scene block_scene(const BenchCase& c) {
   base.point_m = Vec3(0, 0, h);
   base.normal = Vec3(0, 0, -1);
   s.anchors.push_back(base);
+  s.volume.preserve = c.volume;
   return s;
 }
 
@@ -108,6 +110,35 @@ double heun_bytes_per_element(std::size_t real_size, bool hyperelastic) {
   return springs + (hyperelastic ? 2 * stress_pass : 0.0);
 }
 
+/// Device time per kernel over about 0.2 s of steps of the same model on a profiling queue. On
+/// NVIDIA the profiling events make the host the bottleneck, so the profiled step is slower than
+/// the timed one; the per-kernel times remain device times.
+void print_kernel_profile(const ClContext& cl, const Scene& scene, const Lattice& lattice, const ElementArrays& el,
+                          double steps_per_s) {
+  const ClContext profiling(cl.info, true);
+  Simulator sim(scene, lattice, el, profiling);
+  sim.advance(3);
+  sim.check();
+  const std::int64_t steps = std::max<std::int64_t>(20, std::int64_t(0.2 * steps_per_s));
+  const auto t0 = std::chrono::steady_clock::now();
+  sim.advance(steps);
+  const double enqueue_s = seconds_since(t0);
+  profiling.queue.finish();
+  const double wall_s = seconds_since(t0);
+  double total = 0, launches = 0;
+  for (const auto& [name, p] : sim.kernel_profile()) {
+    total += p.seconds;
+    launches += double(p.launches);
+    std::printf("    %-16s %5.2f launches/step %9.2f us/launch %9.2f us/step\n", name.c_str(),
+                double(p.launches) / double(steps), 1e6 * p.seconds / double(p.launches), 1e6 * p.seconds / double(steps));
+  }
+  std::printf("    %.2f launches/step, kernels %.2f us/step of %.2f us/step timed (the rest: gaps between launches); "
+              "profiled run %.2f us/step, host enqueue %.2f us/step\n",
+              launches / double(steps), 1e6 * total / double(steps), 1e6 / steps_per_s, 1e6 * wall_s / double(steps),
+              1e6 * enqueue_s / double(steps));
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o) {
@@ -127,6 +158,9 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     }
     for (const std::string& law : o.laws)
       if (law != "linear") cases.push_back({"block", edge, Integrator::Heun, Precision::Float, law});
+    if (o.volume)
+      for (const std::string& law : o.laws)
+        cases.push_back({"block_volume", edge, Integrator::Heun, Precision::Float, law, true});
   }
   nlohmann::json rows = nlohmann::json::array();
   std::ostringstream csv;
@@ -146,15 +180,18 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     const double effective = bytes * double(n) * sps;
     const char* integ = heun ? "heun" : "symplectic_euler";
     const char* prec = c.precision == Precision::Double ? "double" : "float";
-    std::printf("%-6s %9zu elements  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
+    std::printf("%-12s %9zu elements  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
                 c.name.c_str(), n, c.law.c_str(), integ, prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
+    std::fflush(stdout);
     rows.push_back({{"model", c.name}, {"elements", n}, {"law", c.law}, {"integrator", integ}, {"precision", prec},
                     {"steps_per_s", sps}, {"bytes_per_element_step", bytes}, {"effective_bandwidth_gb_s", effective / 1e9},
                     {"fraction_of_copy_bandwidth", effective / bandwidth},
-                    {"device_bytes_per_element", double(sim.device_bytes()) / double(n)}});
+                    {"device_bytes_per_element", double(sim.device_bytes()) / double(n)},
+                    {"volume_launches_per_projection", c.volume ? sim.volume_launches() : 0}});
     csv << c.name << "," << n << "," << c.law << "," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
         << "\n";
+    if (o.profile) print_kernel_profile(cl, scene, lattice, el, sps);
   }
   result.rows = rows;
   result.csv = csv.str();

@@ -13,6 +13,8 @@ struct ThroughputOptions {
   std::vector<int> sizes;                   ///< block edge lengths in elements
   std::vector<std::string> laws{"linear"};  ///< laws timed with Heun + float
   bool quick = false;                       ///< 0.5 s per timing, Heun + float only
+  bool volume = false;   ///< also time each law with [volume] preserve = true (model "block_volume")
+  bool profile = false;  ///< print device time per kernel (a second, profiling run of each block)
 };
 
 struct ThroughputResult {

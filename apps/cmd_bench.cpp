@@ -33,6 +33,7 @@ const char* kDefaultPhantom = "data-samples/phantom/scene.toml";
 struct BenchOptions {
   std::string out, device, phantom;
   bool quick = false, large = false, no_study = false, dry_run = false, haptic = false;
+  bool volume = false, profile = false;  ///< throughput: block_volume cases; per-kernel device times
   std::vector<int> sizes;  ///< throughput blocks (edge lengths in elements)
   std::vector<int> haptic_elements = {10000};  ///< haptic-rate blocks (about this many elements)
   double haptic_seconds = 3;
@@ -140,6 +141,8 @@ int run_bench(BenchOptions o) {
     ThroughputOptions t;
     t.sizes = o.sizes.empty() ? std::vector<int>{33, 115} : o.sizes;  // 35,937 and 1,520,875 elements
     t.quick = o.quick;
+    t.volume = o.volume;
+    t.profile = o.profile;
     if (!o.laws.empty()) t.laws = o.laws;
     const ThroughputResult tr = run_throughput(*cl, t);
     doc["copy_bandwidth_gb_s"] = tr.copy_bandwidth_gb_s;
@@ -211,6 +214,9 @@ Command add_bench(CLI::App& app) {
   sub->add_flag("--no-study", o->no_study, "skip the speed/accuracy study (throughput only)");
   sub->add_option("--sizes", o->sizes, "throughput: time cubes of these edge lengths in elements (e.g. 33 115)")
       ->check(CLI::Range(2, 1000));
+  sub->add_flag("--volume", o->volume, "throughput: also time each law with [volume] preserve = true (model block_volume)");
+  sub->add_flag("--profile", o->profile, "throughput: print the device time and launches per step of each kernel "
+                                         "(a second run of each block on a profiling queue)");
   sub->add_flag("--dry-run", o->dry_run, "list the scenes and cases without running them");
   sub->add_flag("--haptic", o->haptic, "haptic rate: a probe pressing a block, force output at 1 kHz (with "
                                        "--no-study: only this)");

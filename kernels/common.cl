@@ -24,6 +24,9 @@ typedef float4 real4;
 
 inline real4 xyz0(real4 a) { return (real4)(a.x, a.y, a.z, 0); }
 inline real dot3(real4 a, real4 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+// |a| for lengths far from overflow (lattice connections): OpenCL's length() guards against
+// overflow, which NVIDIA compiles to three divisions and an IEEE square root per call.
+inline real norm3(real4 a) { return sqrt(dot3(a, a)); }
 
 // Rest (voxel-centre) position of the element stored at padded grid cell `cell`.
 // The padded grid has one empty voxel on every side: cell = (i+1) + sy·(j+1) + sz·(k+1).

@@ -85,6 +85,21 @@ inline real4 mat3_apply(mat3 a, real4 v) {
                  a.m[2][0] * v.x + a.m[2][1] * v.y + a.m[2][2] * v.z, 0);
 }
 
+// M·(h·d) for lattice direction d, skipping d's zero components: d is a constant once the
+// neighbour loop is unrolled, and IEEE rules forbid the compiler to drop x·0 itself (a face
+// direction takes 3 multiply-adds instead of 9). The same value as mat3_apply(M, h·d).
+inline real4 mat3_apply_dir(mat3 a, int d, real h) {
+  real4 r = (real4)(0);
+  for (int b = 0; b < 3; ++b) {
+    if (VB_DIR[d][b] == 0) continue;
+    const real hb = h * VB_DIR[d][b];
+    r.x += a.m[0][b] * hb;
+    r.y += a.m[1][b] * hb;
+    r.z += a.m[2][b] * hb;
+  }
+  return r;
+}
+
 inline void mat3_store(global real4* rows, uint e, mat3 a) {
   for (int i = 0; i < 3; ++i) rows[3 * e + i] = (real4)(a.m[i][0], a.m[i][1], a.m[i][2], 0);
 }
@@ -140,16 +155,26 @@ inline mat3 stress_invariants(mat3 C, real J, real c10, real c01) {
   return S;
 }
 
+#if VB_DOUBLE
+#define VB_EPSILON DBL_EPSILON
+#else
+#define VB_EPSILON FLT_EPSILON
+#endif
+
 // Cyclic Jacobi eigen-decomposition of symmetric C: C = V·diag(w)·Vᵀ (robust when eigenvalues
-// coincide, as at rest).
+// coincide, as at rest). An off-diagonal entry below rounding of its diagonal pair is not
+// rotated (the rotation would change the result by rounding only), and the sweeps stop once a
+// sweep rotates nothing: usually after 2–4 sweeps instead of all 8.
 inline void eigen_symmetric(mat3 C, real w[3], mat3* V) {
   mat3 A = C;
   *V = mat3_identity();
   for (int sweep = 0; sweep < 8; ++sweep) {
+    int rotated = 0;
     for (int p = 0; p < 2; ++p)
       for (int q = p + 1; q < 3; ++q) {
         const real apq = A.m[p][q];
-        if (fabs(apq) < (real)1e-30) continue;
+        if (fabs(apq) < (real)1e-30 || fabs(apq) <= VB_EPSILON * (fabs(A.m[p][p]) + fabs(A.m[q][q]))) continue;
+        rotated = 1;
         const real theta = (A.m[q][q] - A.m[p][p]) / (2 * apq);
         const real t = sign(theta) / (fabs(theta) + sqrt(theta * theta + 1)) + (theta == 0 ? 1 : 0);
         const real c = 1 / sqrt(t * t + 1), s = t * c;
@@ -169,6 +194,7 @@ inline void eigen_symmetric(mat3 C, real w[3], mat3* V) {
           V->m[k][q] = s * vkp + c * vkq;
         }
       }
+    if (!rotated) break;
   }
   for (int i = 0; i < 3; ++i) w[i] = A.m[i][i];
 }
@@ -180,13 +206,15 @@ inline mat3 stress_ogden(mat3 C, real J, global const real* mat) {
   mat3 N;
   eigen_symmetric(C, w, &N);
   const real Jc = fmax(J, VB_J_FLOOR);
-  const real scale = pow(Jc, (real)(-1.0 / 3.0));
   const real mean = J > VB_J_FLOOR ? (real)(1.0 / 3.0) : 0;
+  // λ̄_i^α = exp(α·ln λ̄_i), ln λ̄_i = ½ ln w_i − ⅓ ln J_c: three logarithms shared by all terms
+  // instead of a pow per stretch and term
+  const real log_scale = (real)(-1.0 / 3.0) * log(Jc);
   real tau[3];
-  real lbar[3];
+  real log_lbar[3];
   for (int i = 0; i < 3; ++i) {
     w[i] = fmax(w[i], (real)1e-12);
-    lbar[i] = sqrt(w[i]) * scale;
+    log_lbar[i] = (real)0.5 * log(w[i]) + log_scale;
     tau[i] = 0;
   }
   const int terms = (int)mat[1];
@@ -194,7 +222,7 @@ inline mat3 stress_ogden(mat3 C, real J, global const real* mat) {
     const real mu = mat[2 + p], alpha = mat[5 + p];
     real la[3], sum = 0;
     for (int i = 0; i < 3; ++i) {
-      la[i] = pow(lbar[i], alpha);
+      la[i] = exp(alpha * log_lbar[i]);
       sum += la[i];
     }
     for (int i = 0; i < 3; ++i) tau[i] += mu * (la[i] - mean * sum);
@@ -217,6 +245,7 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
   const real4 ue = u[e];
   mat3 A = mat3_zero(), B = mat3_zero();  // B in units of h²
   uint present = 0;
+#pragma unroll
   for (int d = 0; d < 26; ++d) {
     const int j = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
     if (j < 0) continue;
@@ -224,11 +253,15 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
     const real4 uj = u[j];
     const real dX[3] = {VB_DIR[d][0], VB_DIR[d][1], VB_DIR[d][2]};
     const real dx[3] = {h * dX[0] + (uj.x - ue.x), h * dX[1] + (uj.y - ue.y), h * dX[2] + (uj.z - ue.z)};
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
+    // only d's nonzero components (constants once unrolled): adding x·0 changes nothing, but the
+    // compiler may not drop it under IEEE rules
+    for (int b = 0; b < 3; ++b) {
+      if (VB_DIR[d][b] == 0) continue;
+      for (int a = 0; a < 3; ++a) {
         A.m[a][b] += dx[a] * dX[b];  // in units of h (dX dimensionless)
         B.m[a][b] += dX[a] * dX[b];
       }
+    }
   }
   *present_out = present;
   const real detB = mat3_det(B);

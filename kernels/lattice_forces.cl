@@ -68,12 +68,21 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
     const real len = len_sq * inv_len;
     const real4 n = r * inv_len;
     const real Ej = E[j];
+#if VB_DASHPOT
+    // One reciprocal serves both k and the dashpot's reduced mass 1/(wi + wj) in 2ζ√(k·m_red):
+    // q = 1/((Ei + Ej)(wi + wj)), k = κh·2EiEj·(wi + wj)·q, k·m_red = κh·2EiEj·q.
+    const real w_sum = ui.w + uj.w;
+    const real kE = present * VB_KAPPA[d] * h * (2 * Ei * Ej);
+    const real q = 1 / ((Ei + Ej) * w_sum);
+    const real k = kE * w_sum * q;
+#else
     const real k = present * VB_KAPPA[d] * h * (2 * Ei * Ej / (Ei + Ej));
+#endif
 #if VB_REST_OFFSET
     // The connection's rest vector in the unloaded state: h·d plus the change of the two ends'
     // rest offsets (a missing neighbour reads the element itself: h·d, masked out above).
     const real4 r0 = hd + xyz0(rest_offset[j] - u0i);
-    const real rest = sqrt(dot3(r0, r0));
+    const real rest = norm3(r0);
 #else
     const real4 r0 = hd;
     const real rest = h * VB_DIR_LEN[d];
@@ -83,11 +92,16 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
     const int law_j = (int)mat_j[0];
 #endif
 #if VB_HYPER
+#if VB_REST_OFFSET
+#define VB_APPLY_R0(M) mat3_apply(M, r0)
+#else
+#define VB_APPLY_R0(M) mat3_apply_dir(M, d, h)  // r0 = h·d
+#endif
     real magnitude = !VB_LAW_HYPER(law_i) ? spring_end(law_i, mat_i, k, len, rest)
-                                          : hourglass * k * (len - length(mat3_apply(Fi, r0)));
+                                          : hourglass * k * (len - norm3(VB_APPLY_R0(Fi)));
     magnitude += !VB_LAW_HYPER(law_j) ? spring_end(law_j, mat_j, k, len, rest)
-                                      : hourglass * k * (len - length(mat3_apply(mat3_load(Fs, (uint)j), r0)));
-    if (VB_LAW_HYPER(law_j)) f += present * mat3_apply(mat3_load(Qs, (uint)j), hd);
+                                      : hourglass * k * (len - norm3(VB_APPLY_R0(mat3_load(Fs, (uint)j))));
+    if (VB_LAW_HYPER(law_j)) f += present * mat3_apply_dir(mat3_load(Qs, (uint)j), d, h);
     own_offsets += present * hd;
 #elif VB_BIPHASIC
     real magnitude = spring_end(law_i, mat_i, k, len, rest) + spring_end(law_j, mat_j, k, len, rest);
@@ -95,8 +109,7 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
     real magnitude = k * (len - rest);
 #endif
 #if VB_DASHPOT
-    const real reduced_mass = 1 / (ui.w + uj.w);
-    magnitude += 2 * dashpot_ratio * sqrt(k * reduced_mass) * dot3(v[j] - vi, n);
+    magnitude += 2 * dashpot_ratio * sqrt(kE * q) * dot3(v[j] - vi, n);
 #endif
     f += magnitude * n;
   }

@@ -11,7 +11,13 @@
 //   and g = ∂V/∂x of every surface element into `grad` (indexed by element).
 //   volume_finish: one work-group; scalars = {λ, μ, V, p}: λ = (V0 − V)/Σw|g|², μ = Σg·v/Σw|g|²,
 //     p = Σg·f/Σ|g|² (the pressure the check subtracts from the residual).
-//   volume_apply: x += λ·w·g, v −= μ·w·g on the free surface elements.
+//   volume_apply: x += λ·w·g, v −= μ·w·g on the free surface elements; each of its work-groups
+//     sums the partials itself (the same sums in the same order as volume_finish), so a
+//     projection is two launches (partials, apply), not three.
+//   volume_project: the whole projection in one launch. Each work-group adds its partial sums,
+//     and the last one to finish (a count in global memory) sums them all (same order as
+//     volume_finish), writes the scalars and applies x += λ·w·g, v −= μ·w·g to every free surface
+//     element. Work-groups of VB_VOLUME_WG: wide on GPUs, where one group does the applying.
 #define VB_VOLUME_SLOTS 5
 
 inline real4 element_position(uint e, global const real4* u, global const uint* cell_of, int sy,
@@ -19,26 +25,25 @@ inline real4 element_position(uint e, global const real4* u, global const uint* 
   return rest_position(cell_of[e], sy, sz, origin, h) + xyz0(u[e]) - centre;
 }
 
-// Sums each slot of `value` over the work-group into s[k][0] (every work-item must call it).
-inline void sum_over_group(local real (*s)[VB_CHECK_WG], const real* value, uint l) {
-  for (int k = 0; k < VB_VOLUME_SLOTS; ++k) s[k][l] = value[k];
+// Sums each slot of `value` over a work-group of `wg` items into s[k·wg] (every work-item must
+// call it; s holds VB_VOLUME_SLOTS·wg reals).
+inline void sum_over_group(local real* s, uint wg, const real* value, uint l) {
+  for (int k = 0; k < VB_VOLUME_SLOTS; ++k) s[k * wg + l] = value[k];
   barrier(CLK_LOCAL_MEM_FENCE);
-  for (uint stride = VB_CHECK_WG / 2; stride > 0; stride /= 2) {
+  for (uint stride = wg / 2; stride > 0; stride /= 2) {
     if (l < stride)
-      for (int k = 0; k < VB_VOLUME_SLOTS; ++k) s[k][l] += s[k][l + stride];
+      for (int k = 0; k < VB_VOLUME_SLOTS; ++k) s[k * wg + l] += s[k * wg + l + stride];
     barrier(CLK_LOCAL_MEM_FENCE);
   }
 }
 
-kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
-void volume_partials(global const real4* u, global const real4* v, VB_LATTICE_PARAMS,
-                     global const uint* triangles, uint n_triangles,
-                     global const uint* surface_elements, global const uint* incident_start,
-                     global const uint* incident, uint n_surface, real4 centre,
-                     global real4* grad, int with_force, global real* partial) {
-  local real s[VB_VOLUME_SLOTS][VB_CHECK_WG];
-  const uint i = get_global_id(0), l = get_local_id(0);
-  real value[VB_VOLUME_SLOTS];
+// Work-item i's share of the partial sums: triangle i's 6V, and surface element i's terms, whose
+// gradient g it writes to `grad`.
+inline void volume_item_values(uint i, global const real4* u, global const real4* v, VB_LATTICE_PARAMS,
+                               global const uint* triangles, uint n_triangles,
+                               global const uint* surface_elements, global const uint* incident_start,
+                               global const uint* incident, uint n_surface, real4 centre,
+                               global real4* grad, int with_force, real value[VB_VOLUME_SLOTS]) {
   for (int k = 0; k < VB_VOLUME_SLOTS; ++k) value[k] = 0;
   if (i < n_triangles) {
     const real4 a = element_position(triangles[3 * i], u, cell_of, sy, sz, origin, h, centre);
@@ -48,8 +53,11 @@ void volume_partials(global const real4* u, global const real4* v, VB_LATTICE_PA
   }
   if (i < n_surface) {
     const uint e = surface_elements[i];
-    // ∂(x0·(x1 × x2))/∂x0 = x1 × x2, cyclically; incident[] holds 3·triangle + corner
+    // ∂(x0·(x1 × x2))/∂x0 = x1 × x2, cyclically; incident[] holds 3·triangle + corner. Each
+    // term is a chain of four dependent loads (corner, triangle, cell, u): unrolled, the chains of
+    // several triangles overlap on a GPU (the sum keeps its order).
     real4 g = 0;
+#pragma unroll 4
     for (uint k = incident_start[i]; k < incident_start[i + 1]; ++k) {
       const uint t = incident[k] / 3, corner = incident[k] - 3 * t;
       const real4 b = element_position(triangles[3 * t + (corner + 1) % 3], u, cell_of, sy, sz, origin, h, centre);
@@ -67,37 +75,112 @@ void volume_partials(global const real4* u, global const real4* v, VB_LATTICE_PA
       value[4] = dot3(g, f);
     }
   }
-  sum_over_group(s, value, l);
+}
+
+#define VB_VOLUME_MESH_PARAMS                                                                   \
+  global const uint *triangles, uint n_triangles, global const uint *surface_elements,          \
+      global const uint *incident_start, global const uint *incident, uint n_surface, real4 centre
+#define VB_VOLUME_MESH_ARGS triangles, n_triangles, surface_elements, incident_start, incident, n_surface, centre
+
+kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
+void volume_partials(global const real4* u, global const real4* v, VB_LATTICE_PARAMS, VB_VOLUME_MESH_PARAMS,
+                     global real4* grad, int with_force, global real* partial) {
+  local real s[VB_VOLUME_SLOTS * VB_CHECK_WG];
+  const uint l = get_local_id(0);
+  real value[VB_VOLUME_SLOTS];
+  volume_item_values(get_global_id(0), u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, with_force, value);
+  sum_over_group(s, VB_CHECK_WG, value, l);
   if (l == 0)
-    for (int k = 0; k < VB_VOLUME_SLOTS; ++k) partial[get_group_id(0) * VB_VOLUME_SLOTS + k] = s[k][0];
+    for (int k = 0; k < VB_VOLUME_SLOTS; ++k) partial[get_group_id(0) * VB_VOLUME_SLOTS + k] = s[k * VB_CHECK_WG];
+}
+
+// λ, μ, V, p from the partial sums of `groups` work-groups of `wg` items (every work-item must call
+// it; all get the result).
+inline void volume_scalars(volatile global const real* partial, uint groups, real rest_volume, local real* s,
+                           uint wg, uint l, real out[4]) {
+  real value[VB_VOLUME_SLOTS];
+  for (int k = 0; k < VB_VOLUME_SLOTS; ++k) value[k] = 0;
+  for (uint g = l; g < groups; g += wg)
+    for (int k = 0; k < VB_VOLUME_SLOTS; ++k) value[k] += partial[g * VB_VOLUME_SLOTS + k];
+  sum_over_group(s, wg, value, l);
+  const real volume = s[0] / (real)6, wgg = s[wg], gg = s[3 * wg];
+  out[0] = wgg > 0 ? (rest_volume - volume) / wgg : 0;  // λ
+  out[1] = wgg > 0 ? s[2 * wg] / wgg : 0;                // μ
+  out[2] = volume;
+  out[3] = gg > 0 ? s[4 * wg] / gg : 0;                  // p
 }
 
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
 void volume_finish(global const real* partial, uint groups, real rest_volume, global real* scalars) {
-  local real s[VB_VOLUME_SLOTS][VB_CHECK_WG];
+  local real s[VB_VOLUME_SLOTS * VB_CHECK_WG];
   const uint l = get_local_id(0);
-  real value[VB_VOLUME_SLOTS];
-  for (int k = 0; k < VB_VOLUME_SLOTS; ++k) value[k] = 0;
-  for (uint g = l; g < groups; g += VB_CHECK_WG)
-    for (int k = 0; k < VB_VOLUME_SLOTS; ++k) value[k] += partial[g * VB_VOLUME_SLOTS + k];
-  sum_over_group(s, value, l);
-  if (l == 0) {
-    const real volume = s[0][0] / (real)6, wgg = s[1][0], gg = s[3][0];
-    scalars[0] = wgg > 0 ? (rest_volume - volume) / wgg : 0;  // λ
-    scalars[1] = wgg > 0 ? s[2][0] / wgg : 0;                  // μ
-    scalars[2] = volume;
-    scalars[3] = gg > 0 ? s[4][0] / gg : 0;                    // p
-  }
+  real out[4];
+  volume_scalars(partial, groups, rest_volume, s, VB_CHECK_WG, l, out);
+  if (l == 0)
+    for (int k = 0; k < 4; ++k) scalars[k] = out[k];
 }
 
-kernel void volume_apply(global real4* u, global real4* v, global const uint* surface_elements,
-                         uint n_surface, global const real4* grad, global const real* scalars) {
-  const uint i = get_global_id(0);
-  if (i >= n_surface) return;
-  const uint e = surface_elements[i];
+// x += λ·w·g, v −= μ·w·g on free surface element e.
+inline void volume_apply_one(uint e, global real4* u, global real4* v, real4 g, const real out[4]) {
   const real4 ui = u[e];
   if (ui.w == 0) return;
-  const real4 wg = ui.w * grad[e];
-  u[e] = ui + scalars[0] * wg;
-  v[e] = v[e] - scalars[1] * wg;
+  const real4 wg = ui.w * g;
+  u[e] = ui + out[0] * wg;
+  v[e] = v[e] - out[1] * wg;
+}
+
+kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
+void volume_apply(global real4* u, global real4* v, global const uint* surface_elements, uint n_surface,
+                  global const real4* grad, global const real* partial, uint groups, real rest_volume,
+                  global real* scalars) {
+  local real s[VB_VOLUME_SLOTS * VB_CHECK_WG];
+  const uint i = get_global_id(0), l = get_local_id(0);
+  real out[4];
+  volume_scalars(partial, groups, rest_volume, s, VB_CHECK_WG, l, out);
+  if (i == 0)
+    for (int k = 0; k < 4; ++k) scalars[k] = out[k];
+  if (i >= n_surface) return;
+  const uint e = surface_elements[i];
+  volume_apply_one(e, u, v, grad[e], out);
+}
+
+kernel __attribute__((reqd_work_group_size(VB_VOLUME_WG, 1, 1)))
+void volume_project(global real4* u, global real4* v, VB_LATTICE_PARAMS, VB_VOLUME_MESH_PARAMS,
+                    global real4* grad, global real* partial, real rest_volume, global real* scalars,
+                    volatile global uint* groups_done) {
+  local real s[VB_VOLUME_SLOTS * VB_VOLUME_WG];
+  local int last;
+  const uint l = get_local_id(0);
+  real value[VB_VOLUME_SLOTS];
+  volume_item_values(get_global_id(0), u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, 0, value);
+  sum_over_group(s, VB_VOLUME_WG, value, l);
+  if (l == 0)
+    for (int k = 0; k < VB_VOLUME_SLOTS; ++k) partial[get_group_id(0) * VB_VOLUME_SLOTS + k] = s[k * VB_VOLUME_WG];
+  // every work-item's g and the group's partials are globally visible before the group is counted
+  mem_fence(CLK_GLOBAL_MEM_FENCE);
+  barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
+  if (l == 0) last = atomic_inc(groups_done) == get_num_groups(0) - 1;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (!last) return;
+  // The last group: the other groups' partials and gradients are read past any cache (volatile).
+  mem_fence(CLK_GLOBAL_MEM_FENCE);
+  real out[4];
+  volume_scalars(partial, get_num_groups(0), rest_volume, s, VB_VOLUME_WG, l, out);
+  volatile global const real4* g_all = grad;
+  // four elements per round, all loads before the stores, so their latencies overlap
+  for (uint base = l; base < n_surface; base += 4 * VB_VOLUME_WG) {
+    uint e[4];
+    real4 g[4];
+    for (int r = 0; r < 4; ++r) {
+      const uint k = base + r * VB_VOLUME_WG;
+      e[r] = k < n_surface ? surface_elements[k] : 0xffffffffu;
+    }
+    for (int r = 0; r < 4; ++r) g[r] = e[r] != 0xffffffffu ? g_all[e[r]] : (real4)(0);
+    for (int r = 0; r < 4; ++r)
+      if (e[r] != 0xffffffffu) volume_apply_one(e[r], u, v, g[r], out);
+  }
+  if (l == 0) {
+    for (int k = 0; k < 4; ++k) scalars[k] = out[k];
+    *groups_done = 0;  // ready for the next launch
+  }
 }

@@ -105,8 +105,11 @@ DeviceInfo select_device(const std::string& selector_in) {
   return *pick;
 }
 
-ClContext::ClContext(const DeviceInfo& device)
-    : info(device), context(device.device), queue(context, device.device) {}
+ClContext::ClContext(const DeviceInfo& device, bool profiling)
+    : info(device),
+      context(device.device),
+      queue(context, device.device, profiling ? cl_command_queue_properties(CL_QUEUE_PROFILING_ENABLE) : 0),
+      profiling(profiling) {}
 
 const char* embedded_kernel(const std::string& file_name) {
   for (const auto& [name, text] : kernels::embedded_sources())
@@ -138,8 +141,20 @@ cl::Program build_program(const ClContext& cl, const std::vector<std::string>& f
     if (const auto it = cache.find(key); it != cache.end()) return it->second;
   }
   cl::Program program(cl.context, source);
+  std::string build_options = options;
+  if (const char* extra = std::getenv("VOXBREAST_CL_OPTIONS")) build_options += std::string(" ") + extra;
   try {
-    program.build({cl.info.device}, options.c_str());
+    program.build({cl.info.device}, build_options.c_str());
+    if (const char* dir = std::getenv("VOXBREAST_DUMP_KERNELS")) {
+      // the device's binary (PTX on NVIDIA) and build log, named by the options' hash
+      const std::string stem =
+          (std::filesystem::path(dir) / ("program_" + std::to_string(std::hash<std::string>{}(build_options)))).string();
+      std::ofstream(stem + ".log") << build_options << "\n" << program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(cl.info.device);
+      const auto binaries = program.getInfo<CL_PROGRAM_BINARIES>();
+      if (!binaries.empty())
+        std::ofstream(stem + ".bin", std::ios::binary)
+            .write(reinterpret_cast<const char*>(binaries[0].data()), std::streamsize(binaries[0].size()));
+    }
   } catch (const cl::Error& e) {
     std::string log;
     try {

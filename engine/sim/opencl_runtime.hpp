@@ -26,18 +26,22 @@ std::vector<DeviceInfo> list_devices();
 /// the first device whose platform or name contains it (case-insensitive).
 DeviceInfo select_device(const std::string& selector);
 
-/// A context and in-order queue on one device.
+/// A context and in-order queue on one device; `profiling` records kernel times (voxbreast bench
+/// --profile).
 struct ClContext {
   DeviceInfo info;
   cl::Context context;
   cl::CommandQueue queue;
-  explicit ClContext(const DeviceInfo& device);
+  bool profiling = false;
+  explicit ClContext(const DeviceInfo& device, bool profiling = false);
 };
 
 /// Builds a program from embedded kernel files (names as in kernels/, e.g. "common.cl"), in
 /// order, after `prelude_front` (inserted after the first file). Each file keeps its own line
 /// numbers in compiler messages. On failure throws vb::Error carrying the build log. When
-/// $VOXBREAST_DUMP_KERNELS names a folder, the final source and options are written there.
+/// $VOXBREAST_DUMP_KERNELS names a folder, the final source and options are written there, and
+/// per build the device binary (PTX on NVIDIA) and the build log (with
+/// VOXBREAST_CL_OPTIONS=-cl-nv-verbose: registers and spills per kernel).
 /// Programs are cached per context and (source, options) for the life of the process.
 cl::Program build_program(const ClContext& cl, const std::vector<std::string>& files,
                           const std::string& prelude_after_first, const std::string& options);

@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include "engine/device/torus.hpp"
 #include "engine/error.hpp"
@@ -14,6 +15,9 @@ namespace vb {
 namespace {
 
 constexpr int kCheckWorkGroup = 128;
+// volume_project's work-groups on GPUs (kernels/volume.cl): its last group applies the projection
+// to the whole surface, so wide groups keep that tail short
+constexpr std::size_t kVolumeGpuWorkGroup = 512;
 constexpr int kCheckBaseSlots = 5, kCheckSlotsPerIndenter = 4;  // kernels/checks.cl
 constexpr int kCheckSlotsPerTorus = 8;                             // VB_TORUS_SLOTS
 constexpr int kIndenterStride = 20;                                // VB_IND_STRIDE
@@ -29,6 +33,10 @@ constexpr int kCheckVolume = kCheckIndenter + kIndenterArgs + 3;  // VB_VOLUME: 
 constexpr int kVolumeSlots = 5, kVolumeScalars = 4;
 constexpr int kVolumeMesh = 2 + kLatticeArgs;  // triangles, n_tri, surface, start, incident, n_surf
 constexpr int kVolumeCentre = kVolumeMesh + 6, kVolumeWithForce = kVolumeMesh + 8;
+// volume_project: u, v, the lattice parameters, the mesh, centre, then grad, partial, V0, scalars, count
+constexpr int kProjectGrad = kVolumeCentre + 1, kProjectRestVolume = kVolumeCentre + 3;
+// volume_apply: u, v, surface, n_surface, grad, partial, groups, V0, scalars
+constexpr int kApplyRestVolume = 7;
 
 template <typename T>
 std::vector<T> pack4(const std::vector<double>& xyz, const std::vector<double>* w) {
@@ -198,6 +206,16 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_BIPHASIC=" + std::to_string(el.biphasic);
   options += " -DVB_CHECK_WG=" + std::to_string(kCheckWorkGroup);
   options += " -DVB_VOLUME=" + std::to_string(volume_);
+  if (volume_) {
+    // A projection is one launch (volume_project) unless VOXBREAST_VOLUME_LAUNCHES=2 asks for the
+    // two-launch form (volume_partials, volume_apply), kept to compare the two on a device.
+    if (const char* env = std::getenv("VOXBREAST_VOLUME_LAUNCHES")) volume_launches_ = std::atoi(env) == 2 ? 2 : 1;
+    const bool wide = cl.info.is_gpu &&
+                      cl.info.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>() >= kVolumeGpuWorkGroup &&
+                      kVolumeSlots * kVolumeGpuWorkGroup * real_size_ + 64 <= local_bytes;
+    volume_wg_ = wide ? kVolumeGpuWorkGroup : std::size_t(kCheckWorkGroup);
+    options += " -DVB_VOLUME_WG=" + std::to_string(volume_wg_);
+  }
   const bool friction = std::any_of(scene.tori.begin(), scene.tori.end(), [](const TorusSpec& t) { return t.friction > 0; });
   options += " -DVB_TORI=" + std::to_string(scene.tori.size());
   options += " -DVB_TORUS_BASE=" + std::to_string(torus_table_base());
@@ -286,7 +304,7 @@ void Simulator::set_rest_offsets(const std::vector<double>& u0) {
     for (std::size_t i = 0; i < unloaded.size(); ++i) unloaded[i] += u0[i];
     const double lattice_volume = double(surface_.complete_cell_count) * std::pow(lattice_.spacing_m, 3);
     rest_volume_m3_ = lattice_volume * vb::enclosed_volume_m3(surface_, unloaded) / vb::enclosed_volume_m3(surface_, rest);
-    set_real(vol_finish_, 2, frame_sign_ * rest_volume_m3_);
+    set_rest_volume_args();
   }
   cl_.queue.finish();
 }
@@ -336,6 +354,8 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   std::vector<char> zeros(4 * real_size_ * n_, 0);  // gradient: zero off the surface
   vol_grad_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, zeros.size(), zeros.data());
   vol_partial_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, volume_groups_ * kVolumeSlots * real_size_);
+  const cl_uint zero = 0;  // volume_project's count of finished work-groups
+  vol_done_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof zero, const_cast<cl_uint*>(&zero));
   std::vector<char> scalar_zeros(kVolumeScalars * real_size_, 0);
   vol_scalars_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, scalar_zeros.size(),
                             scalar_zeros.data());
@@ -360,29 +380,61 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   vol_apply_.setArg(2, vol_surface_);
   vol_apply_.setArg(3, cl_uint(volume_surface_));
   vol_apply_.setArg(4, vol_grad_);
-  vol_apply_.setArg(5, vol_scalars_);
+  vol_apply_.setArg(5, vol_partial_);
+  vol_apply_.setArg(6, cl_uint(volume_groups_));
+  vol_apply_.setArg(kApplyRestVolume + 1, vol_scalars_);
+  vol_project_ = cl::Kernel(program_, "volume_project");
+  set_lattice_args(vol_project_, 2);
+  vol_project_.setArg(kVolumeMesh + 0, vol_triangles_);
+  vol_project_.setArg(kVolumeMesh + 1, cl_uint(volume_triangles_));
+  vol_project_.setArg(kVolumeMesh + 2, vol_surface_);
+  vol_project_.setArg(kVolumeMesh + 3, vol_incident_start_);
+  vol_project_.setArg(kVolumeMesh + 4, vol_incident_);
+  vol_project_.setArg(kVolumeMesh + 5, cl_uint(volume_surface_));
+  set_world_vector(vol_project_, kVolumeCentre, centre);
+  vol_project_.setArg(kProjectGrad, vol_grad_);
+  vol_project_.setArg(kProjectGrad + 1, vol_partial_);
+  vol_project_.setArg(kProjectRestVolume + 1, vol_scalars_);
+  vol_project_.setArg(kProjectRestVolume + 2, vol_done_);
+  set_rest_volume_args();
   check_.setArg(kCheckVolume, vol_grad_);
   check_.setArg(kCheckVolume + 1, vol_scalars_);
 }
 
+void Simulator::set_rest_volume_args() {
+  const double v0 = frame_sign_ * rest_volume_m3_;  // lattice frame
+  set_real(vol_finish_, 2, v0);
+  set_real(vol_apply_, kApplyRestVolume, v0);
+  set_real(vol_project_, kProjectRestVolume, v0);
+}
+
 void Simulator::enqueue_volume_sums(bool with_force) { enqueue_volume_sums(with_force, u_, v_); }
 
-void Simulator::enqueue_volume_sums(bool with_force, const cl::Buffer& u, const cl::Buffer& v) {
+void Simulator::enqueue_volume_partials(bool with_force, const cl::Buffer& u, const cl::Buffer& v) {
   vol_partials_.setArg(0, u);
   vol_partials_.setArg(1, v);
   vol_partials_.setArg(kVolumeWithForce, cl_int(with_force));
-  const cl::NDRange wg(kCheckWorkGroup);
-  cl_.queue.enqueueNDRangeKernel(vol_partials_, cl::NullRange, cl::NDRange(volume_groups_ * kCheckWorkGroup), wg);
-  cl_.queue.enqueueNDRangeKernel(vol_finish_, cl::NullRange, wg, wg);
+  launch(vol_partials_, cl::NDRange(volume_groups_ * kCheckWorkGroup), cl::NDRange(kCheckWorkGroup));
+}
+
+void Simulator::enqueue_volume_sums(bool with_force, const cl::Buffer& u, const cl::Buffer& v) {
+  enqueue_volume_partials(with_force, u, v);
+  launch(vol_finish_, cl::NDRange(kCheckWorkGroup), cl::NDRange(kCheckWorkGroup));
 }
 
 void Simulator::enqueue_volume_correction(const cl::Buffer& u, const cl::Buffer& v) {
-  enqueue_volume_sums(false, u, v);
+  if (volume_launches_ == 1) {  // sums, λ and μ, and the projection in one launch
+    vol_project_.setArg(0, u);
+    vol_project_.setArg(1, v);
+    const std::size_t groups = (std::max(volume_triangles_, volume_surface_) + volume_wg_ - 1) / volume_wg_;
+    launch(vol_project_, cl::NDRange(groups * volume_wg_), cl::NDRange(volume_wg_));
+    return;
+  }
+  enqueue_volume_partials(false, u, v);  // volume_apply sums the partials itself: no volume_finish
   vol_apply_.setArg(0, u);
   vol_apply_.setArg(1, v);
   const std::size_t wg = kCheckWorkGroup, global = (volume_surface_ + wg - 1) / wg * wg;
-  cl_.queue.enqueueNDRangeKernel(vol_apply_, cl::NullRange, cl::NDRange(global),
-                                 cl_.info.is_gpu ? cl::NDRange(wg) : cl::NullRange);
+  launch(vol_apply_, cl::NDRange(global), cl::NDRange(wg));
 }
 
 double Simulator::enclosed_volume_m3() {
@@ -593,7 +645,28 @@ void Simulator::set_indenter_args(cl::Kernel& k, int a, double t_force, double t
   set_real(k, a + 2, t_project);
 }
 
-void Simulator::enqueue(cl::Kernel& k) const { cl_.queue.enqueueNDRangeKernel(k, cl::NullRange, global_, local_); }
+void Simulator::launch(cl::Kernel& k, const cl::NDRange& global, const cl::NDRange& local) const {
+  if (!cl_.profiling) {
+    cl_.queue.enqueueNDRangeKernel(k, cl::NullRange, global, local);
+    return;
+  }
+  cl::Event e;
+  cl_.queue.enqueueNDRangeKernel(k, cl::NullRange, global, local, nullptr, &e);
+  events_.emplace_back(k.getInfo<CL_KERNEL_FUNCTION_NAME>(), e);
+}
+
+std::map<std::string, KernelProfile> Simulator::kernel_profile() const {
+  std::map<std::string, KernelProfile> out;
+  cl_.queue.finish();
+  for (const auto& [name, e] : events_) {
+    const auto ns = e.getProfilingInfo<CL_PROFILING_COMMAND_END>() - e.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+    out[name].launches += 1;
+    out[name].seconds += 1e-9 * double(ns);
+  }
+  return out;
+}
+
+void Simulator::enqueue(cl::Kernel& k) const { launch(k, global_, local_); }
 
 void Simulator::enqueue_stress(const cl::Buffer& u) {
   if (!hyper_) return;
@@ -603,7 +676,7 @@ void Simulator::enqueue_stress(const cl::Buffer& u) {
 
 void Simulator::enqueue_check() const {
   // check_state declares reqd_work_group_size, so its local size is always given
-  cl_.queue.enqueueNDRangeKernel(check_, cl::NullRange, global_, cl::NDRange(kCheckWorkGroup));
+  launch(check_, global_, cl::NDRange(kCheckWorkGroup));
 }
 
 void Simulator::advance(std::int64_t steps) {
@@ -611,6 +684,7 @@ void Simulator::advance(std::int64_t steps) {
   const double dt = dt_.dt_s;
   const bool has_paths = std::any_of(scene_.indenters.begin(), scene_.indenters.end(),
                                      [](const IndenterSpec& ind) { return ind.path.size() >= 2; });
+  events_.clear();
   for (std::int64_t s = 0; s < steps; ++s, ++steps_) {
     const double t0 = double(steps_) * dt, t1 = double(steps_ + 1) * dt;
     if (has_paths) follow_paths(t0);
@@ -718,7 +792,10 @@ void Simulator::set_gravity(const Vec3& g) {
   for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_})
     if ((*k)()) set_world_vector(*k, kStepLattice + 7, g);
   set_world_vector(check_, kCheckLattice + 7, g);
-  if (volume_) set_world_vector(vol_partials_, 2 + 7, g);
+  if (volume_) {
+    set_world_vector(vol_partials_, 2 + 7, g);
+    set_world_vector(vol_project_, 2 + 7, g);
+  }
 }
 
 template <typename T>

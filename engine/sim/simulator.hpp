@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/lattice/lattice.hpp"
@@ -68,6 +71,12 @@ std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Prec
 std::size_t estimated_volume_device_bytes(std::size_t elements, std::size_t surface_elements,
                                           std::size_t triangles, Precision precision);
 
+/// Device time per kernel while profiling (ClContext with profiling on): launches and seconds.
+struct KernelProfile {
+  std::int64_t launches = 0;
+  double seconds = 0;
+};
+
 class Simulator {
  public:
   /// Uploads the model. Throws vb::Error for double precision on a device without fp64, a model
@@ -122,6 +131,12 @@ class Simulator {
   /// contact pressures divide by
   const std::vector<double>& contact_area_m2() const { return contact_area_host_; }
   const ClContext& context() const { return cl_; }
+  /// kernel launches of the last advance() on a profiling queue (ClContext with profiling on),
+  /// by kernel name; waits for the device
+  std::map<std::string, KernelProfile> kernel_profile() const;
+  /// kernel launches per projection of the volume constraint: 1 (volume_project) or 2
+  /// (volume_partials, volume_apply; VOXBREAST_VOLUME_LAUNCHES=2)
+  int volume_launches() const { return volume_launches_; }
 
  private:
   void set_indenter_args(cl::Kernel& k, int first_arg, double t_force, double t_project);
@@ -188,23 +203,31 @@ class Simulator {
   bool rest_offsets_ = false;
   cl::Buffer rest_offset_, rest_frame_;  ///< u0 per element; R₀ rows and J₀ (hyperelastic)
   mutable cl::Kernel check_;
+  /// enqueues k (records its event on a profiling queue)
+  void launch(cl::Kernel& k, const cl::NDRange& global, const cl::NDRange& local) const;
+  mutable std::vector<std::pair<std::string, cl::Event>> events_;  ///< profiling queues only
 
   // Volume constraint ([volume] preserve): the surface mesh, uploaded once.
   void make_volume_buffers(const SurfaceMesh& mesh);
   /// enqueues the partial sums (with the residual pressure when with_force) and λ, μ, V, p
   void enqueue_volume_sums(bool with_force);
   void enqueue_volume_sums(bool with_force, const cl::Buffer& u, const cl::Buffer& v);
+  void enqueue_volume_partials(bool with_force, const cl::Buffer& u, const cl::Buffer& v);
   /// projects the state (u, v) onto V = V0 and removes its velocity along g
   void enqueue_volume_correction(const cl::Buffer& u, const cl::Buffer& v);
   /// V (m³, world frame) from the last volume_finish
   double read_enclosed_volume_m3() const;
+  /// the rest volume (lattice frame) into the kernels that compute λ
+  void set_rest_volume_args();
   bool volume_ = false;
   SurfaceMesh surface_;
   double rest_volume_m3_ = 0, frame_sign_ = 1;  ///< det(rotation): lattice-frame V = sign·V_world
   std::size_t volume_triangles_ = 0, volume_surface_ = 0, volume_groups_ = 0;
+  std::size_t volume_wg_ = 0;   ///< work-group size of volume_project (VB_VOLUME_WG)
+  int volume_launches_ = 1;     ///< per projection: 1 volume_project, 2 volume_partials + volume_apply
   cl::Buffer vol_triangles_, vol_surface_, vol_incident_start_, vol_incident_, vol_grad_, vol_partial_,
-      vol_scalars_;
-  cl::Kernel vol_partials_, vol_finish_, vol_apply_;
+      vol_scalars_, vol_done_;
+  cl::Kernel vol_partials_, vol_finish_, vol_apply_, vol_project_;
 };
 
 }  // namespace vb
