@@ -43,6 +43,12 @@ int run_probe(const ProbeOptions& o) {
   if (r.unconverged_increments > 0)
     std::fprintf(stderr, "voxbreast: warning: %lld increments stopped at stop.max_steps before equilibrium\n",
                  (long long)r.unconverged_increments);
+  for (std::size_t k = 0; k < r.presses.size(); ++k)
+    if (r.presses[k].inverted)
+      std::fprintf(stderr,
+                   "voxbreast: warning: press %zu folded the lattice (det F = %.3g <= 0 under the indenter): its force is "
+                   "not physical; press less deep, or use a hyperelastic law (docs/PROBING.md, \"Validity\")\n",
+                   k + 1, r.presses[k].min_det_f);
   std::printf("%lld steps in %.1f s\nwrote %s/probe_curves.csv, probe_profile.csv, probe_summary.json\n",
               (long long)r.total_steps, r.wall_time_s, o.out.c_str());
   return 0;

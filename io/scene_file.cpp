@@ -653,12 +653,12 @@ AnchorSpec read_anchor(const std::string& name, const Section& s) {
 }
 
 const NameTable<IndenterSpec::Kind> kIndenterKinds = {
-    {"sphere", IndenterSpec::Kind::Sphere, {"kind", "radius", "start", "velocity", "travel_time", "path", "contact"}},
-    {"plate", IndenterSpec::Kind::Plate, {"kind", "start", "normal", "velocity", "travel_time", "path", "contact"}},
+    {"sphere", IndenterSpec::Kind::Sphere, {"kind", "radius", "start", "velocity", "travel_time", "path", "contact", "friction"}},
+    {"plate", IndenterSpec::Kind::Plate, {"kind", "start", "normal", "velocity", "travel_time", "path", "contact", "friction"}},
     {"cylinder", IndenterSpec::Kind::Cylinder,
-     {"kind", "radius", "axis", "start", "velocity", "travel_time", "path", "contact"}},
+     {"kind", "radius", "axis", "start", "velocity", "travel_time", "path", "contact", "friction"}},
     {"capsule", IndenterSpec::Kind::Capsule,
-     {"kind", "radius", "axis", "length", "start", "velocity", "travel_time", "path", "contact"}},
+     {"kind", "radius", "axis", "length", "start", "velocity", "travel_time", "path", "contact", "friction"}},
 };
 
 const NameTable<IndenterSpec::Contact> kContacts = {
@@ -678,6 +678,9 @@ IndenterSpec read_indenter(const Section& s, const std::string& scene_dir) {
     i.normal = s.required("axis", s.direction("axis"));
   if (i.kind == IndenterSpec::Kind::Capsule) i.length_m = s.required("length", s.positive("length"));
   if (const auto* n = s.named("contact", kContacts)) i.contact = n->value;
+  i.friction = s.non_negative("friction").value_or(0.0);
+  if (i.friction > 0 && i.contact != IndenterSpec::Contact::Push)
+    s.fail("friction", "applies to contact = \"push\" only", "'slide' is frictionless and 'stick' has no slip: remove 'friction'");
   if (const auto path = s.text("path")) {
     for (const char* key : {"start", "velocity", "travel_time"})
       if (s.find(key)) s.fail(key, "a trajectory ('path') gives the positions already", "remove '" + std::string(key) + "'");

@@ -42,13 +42,7 @@ VB_INLINE void torus_check(real4* f, real4 x, global const real* table, int i, r
   real4 carried = torus_constrain(f, x, table, tor, t, h, &grip);
   const real fn = -dot3(carried, n);  // compressive normal force (N), ≥ 0
 #if VB_FRICTION
-  if (fn > 0 && tor[3] > 0) {
-    const real4 ft = *f - dot3(*f, n) * n;
-    const real size = length(ft), limit = tor[3] * fn;
-    const real4 held = size <= limit ? ft : ft * (limit / size);
-    *f -= held;
-    carried += held;
-  }
+  if (fn > 0 && tor[3] > 0) carried += friction_hold(f, n, fn, tor[3]);
 #endif
   real* slot = value + VB_TORUS_SLOT0 + VB_TORUS_SLOTS * i;
   slot[0] = carried.x;
@@ -117,7 +111,12 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
 #if VB_INDENTERS
       const real4 x = rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui);
       for (int i = 0; i < VB_INDENTERS; ++i) {
-        const real4 reaction = contact_constrain(&f, x, indenters + VB_IND_STRIDE * i, t_force, h);
+        torus_grip grip = {0};
+        real4 reaction = contact_constrain(&f, x, indenters + VB_IND_STRIDE * i, t_force, h, &grip);
+#if VB_FRICTION
+        // Friction carries the tangential force up to μ·|f_n| (grip_n = μ·|f_n|).
+        if (grip.grip_n > 0) reaction += friction_hold(&f, grip.normal, length(xyz0(reaction)), indenters[VB_IND_STRIDE * i + 17]);
+#endif
         value[5 + 4 * i] = reaction.x;
         value[6 + 4 * i] = reaction.y;
         value[7 + 4 * i] = reaction.z;

@@ -57,8 +57,9 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
 // 0–2 start (m), 3 radius (m; -1 for a plate), 4–6 plate normal into the tissue / cylinder and
 // capsule axis (unit), 8–10 velocity (m/s), 12 travel time (s), 13 contact: 0 push, 1 slide,
 // 2 stick, 14 kind: 0 sphere, 1 plate, 2 cylinder, 3 capsule, 15 capsule segment length (m),
-// 16 time t0 (s) at which the indenter is at `start`; 7, 11 and 17–19 unused: new columns go at
-// the end), the time forces are evaluated at, and the time stage positions are projected at.
+// 16 time t0 (s) at which the indenter is at `start`, 17 Coulomb friction μ (push contact);
+// 7, 11, 18 and 19 unused: new columns go at the end), the time forces are evaluated at, and
+// the time stage positions are projected at.
 // A 1-row placeholder when VB_INDENTERS is 0. Torus rows and their
 // inflation knots follow from VB_TORUS_BASE (kernels/device_contact.cl): the rigid-obstacle table.
 #define VB_IND_STRIDE 20

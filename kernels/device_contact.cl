@@ -4,7 +4,7 @@
 //   -DVB_TORI=count       number of tori (0: nothing here is compiled but the no-op grip)
 //   -DVB_TORUS_BASE=N     offset (reals) of the first torus row in the rigid-obstacle table
 //                         (the `indenters` argument: indenter rows, then torus rows, then knots)
-//   -DVB_FRICTION=0|1     some torus has friction
+//   -DVB_FRICTION=0|1     some torus or indenter has friction (the grip helpers serve both)
 // Torus row (lattice frame, VB_TORUS_STRIDE reals): 0–2 centre (m), 3 friction coefficient μ,
 // 4–6 unit axis, 7 knot count K, 8–10 a unit vector ⟂ axis (the radial direction on the axis),
 // 11 offset of its knots in the table: K rows of VB_KNOT_STRIDE reals: time t_i (s), minor and major
@@ -24,6 +24,28 @@ typedef struct {
   real4 normal;
   real4 surface_v;
 } torus_grip;
+
+// Coulomb friction shared by the torus device and the push indenters (lattice_forces.cl): a
+// contact that carries `push` (≤ 0: its normal force or acceleration along n) with coefficient mu
+// adds mu·|push| to the grip; the last gripping contact gives the normal and surface velocity.
+VB_INLINE void grip_add(torus_grip* g, real push, real mu, real4 n, real4 surface_v) {
+#if VB_FRICTION
+  const int gripping = push < 0 && mu > 0;
+  g->grip_n -= gripping ? push * mu : (real)0;
+  g->normal = gripping ? n : g->normal;
+  g->surface_v = gripping ? surface_v : g->surface_v;
+#endif
+}
+
+// At a check: the tangential part of f (to n) that friction holds, at most mu·fn (fn ≥ 0, the
+// compressive normal force); removed from f and returned (the contact carries it).
+VB_INLINE real4 friction_hold(real4* f, real4 n, real fn, real mu) {
+  const real4 ft = *f - dot3(*f, n) * n;
+  const real size = length(ft), limit = mu * fn;
+  const real4 held = size <= limit ? ft : ft * (limit / size);
+  *f -= held;
+  return held;
+}
 
 #if VB_TORI
 VB_INLINE global const real* torus_row(global const real* table, int i) {
@@ -91,12 +113,7 @@ VB_INLINE real4 torus_constrain(real4* f, real4 x, global const real* table, glo
   const real fn = dot3(*f, n);
   const real push = dist <= REAL_CONTACT_TOL * h && fn < 0 ? fn : (real)0;  // ≤ 0
   *f -= push * n;
-#if VB_FRICTION
-  const int gripping = push < 0 && tor[3] > 0;
-  grip->grip_n -= gripping ? push * tor[3] : (real)0;
-  grip->normal = gripping ? n : grip->normal;
-  grip->surface_v = gripping ? w : grip->surface_v;
-#endif
+  grip_add(grip, push, tor[3], n, w);
   return push * n;
 }
 

@@ -7,15 +7,17 @@
 //     corrector u' = u + dt/2·(v + ṽ), v' = v + dt/2·(a(u, v) + a(ũ, ṽ)) = (v + ṽ)/2 + dt/2·a(ũ, ṽ)
 //     (a(u, v) is recovered from ṽ, so no force buffer is stored).
 
+// `grip` collects the indenters' friction (device_contact.cl), turned into m/s² like the torus's.
 inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                          VB_LATTICE_PARAMS, global const real* indenters, real t) {
+                          VB_LATTICE_PARAMS, global const real* indenters, real t, torus_grip* grip) {
   real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
 #if VB_GLOBAL_DAMPING
   f -= damping * xyz0(vi) / ui.w;
 #endif
 #if VB_INDENTERS
-  contact_constrain_all(&f, rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui), indenters, t, h);
+  contact_constrain_all(&f, rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui), indenters, t, h, grip);
 #endif
+  grip->grip_n *= ui.w;
   return f * ui.w;
 }
 
@@ -43,21 +45,17 @@ inline void explicit_stage(global const real4* u, global const real4* v, global 
   if (e >= n) return;
   real4 ui = u[e], vi = v[e];
   if (ui.w != 0) {
-    real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force);
+    torus_grip grip = {0};  // friction of the indenters and tori (no-op without VB_FRICTION)
+    real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force, &grip);
 #if VB_TORI
     const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
-    torus_grip grip = {0};
     torus_constrain_all(&a, X + xyz0(ui), indenters, t_force, h, &grip);
 #endif
     if (symplectic) vi += dt * a;
-#if VB_TORI
     if (symplectic) torus_apply_grip(&vi, grip, dt);
-#endif
     ui += dt * xyz0(vi);
     if (!symplectic) vi += dt * a;
-#if VB_TORI
     if (!symplectic) torus_apply_grip(&vi, grip, dt);
-#endif
     finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, indenters, t_project);
   }
   u_out[e] = ui;
@@ -84,16 +82,14 @@ kernel void heun_correct(global real4* u, global real4* v, global const real4* u
   real4 ui = u[e];
   if (ui.w == 0) return;
   const real4 vi = v[e], up = u_pred[e], vp = v_pred[e];
-  real4 a = acceleration(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t_force);
+  torus_grip grip = {0};
+  real4 a = acceleration(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t_force, &grip);
 #if VB_TORI
   const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
-  torus_grip grip = {0};
   torus_constrain_all(&a, X + xyz0(up), indenters, t_force, h, &grip);
 #endif
   real4 vn = xyz0((vi + vp) * (real)0.5 + (real)0.5 * dt * a);
-#if VB_TORI
   torus_apply_grip(&vn, grip, (real)0.5 * dt);  // the predictor's half reaches vn through ṽ
-#endif
   ui += (real)0.5 * dt * xyz0(vi + vp);
   finish_stage(e, &ui, &vn, cell_of, sy, sz, origin, h, indenters, t_project);
   u[e] = ui;

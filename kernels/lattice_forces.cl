@@ -183,12 +183,14 @@ inline real indenter_distance(real4 x, global const real* ind, real t, real4* n_
   return dist - ind[3];
 }
 
-// Contact of a touching element (within REAL_CONTACT_TOL·h of the surface). Push: frictionless
-// and unilateral, the indenter carries the inward normal part of the element's force. Slide: held
-// on the surface, the indenter carries the whole normal part (pull too), the element slides
-// freely along it. Stick: the element moves with the indenter, which carries all of its force.
+// Contact of a touching element (within REAL_CONTACT_TOL·h of the surface). Push: unilateral,
+// the indenter carries the inward normal part of the element's force; with a friction
+// coefficient μ (column 17) it adds μ·|f_n| to the element's grip (device_contact.cl: Coulomb
+// friction at the velocity level, against the indenter's velocity). Slide: held on the surface,
+// the indenter carries the whole normal part (pull too), the element slides freely along it.
+// Stick: the element moves with the indenter, which carries all of its force.
 // Returns the part carried (force on the indenter, N) and removes it from f.
-inline real4 contact_constrain(real4* f, real4 x, global const real* ind, real t, real h) {
+inline real4 contact_constrain(real4* f, real4 x, global const real* ind, real t, real h, torus_grip* grip) {
   real4 n;
   const real dist = indenter_distance(x, ind, t, &n);
   const int mode = (int)ind[13];
@@ -201,11 +203,14 @@ inline real4 contact_constrain(real4* f, real4 x, global const real* ind, real t
   const real fn = dot3(*f, n);
   if (mode == 0 && fn >= 0) return (real4)(0);
   *f -= fn * n;
+#if VB_FRICTION
+  if (mode == 0) grip_add(grip, fn, ind[17], n, indenter_velocity(ind, t));
+#endif
   return fn * n;
 }
 
-inline void contact_constrain_all(real4* f, real4 x, global const real* indenters, real t, real h) {
-  for (int i = 0; i < VB_INDENTERS; ++i) contact_constrain(f, x, indenters + VB_IND_STRIDE * i, t, h);
+inline void contact_constrain_all(real4* f, real4 x, global const real* indenters, real t, real h, torus_grip* grip) {
+  for (int i = 0; i < VB_INDENTERS; ++i) contact_constrain(f, x, indenters + VB_IND_STRIDE * i, t, h, grip);
 }
 
 // Moves an element that ended inside an indenter back onto its surface; its normal velocity

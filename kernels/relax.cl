@@ -15,15 +15,14 @@ kernel void relax_step(global const real4* u, global const real4* v, global real
   if (ui.w != 0) {
     // acceleration() is f/m with the indenters' constraint (no global damping is compiled in);
     // m/m̃ turns it into f/m̃, then the fictitious damping.
-    real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force) * relax_scale[e] - c * xyz0(vi);
+    torus_grip grip = {0};  // on the acceleration, as in integrate.cl (the indenters' scaled here)
+    real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force, &grip) * relax_scale[e] - c * xyz0(vi);
+    grip.grip_n *= relax_scale[e];
 #if VB_TORI
-    torus_grip grip = {0};  // on the acceleration, as in integrate.cl
     torus_constrain_all(&a, rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui), indenters, t_force, h, &grip);
 #endif
     vi = xyz0(vi + dt * a);
-#if VB_TORI
     torus_apply_grip(&vi, grip, dt);
-#endif
     ui += dt * vi;
     finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, indenters, t_project);
   }

@@ -3,9 +3,12 @@
 #include <chrono>
 #include <cmath>
 
+#include <Eigen/LU>
+
 #include "engine/error.hpp"
 #include "engine/probe/force_profile.hpp"
 #include "engine/probe/indenter_shape.hpp"
+#include "engine/results/element_measures.hpp"
 #include "engine/sim/run.hpp"
 #include "engine/surface/surface_area.hpp"
 
@@ -151,6 +154,20 @@ ProbeResult run_press_line(const Scene& scene, const Lattice& lattice, const Ele
       for (std::size_t e = 0; e < area.size(); ++e)
         if (area[e] > 0 && indenter_signed_distance(ind, at, Vec3(x[3 * e], x[3 * e + 1], x[3 * e + 2])) <= kContactTol * h)
           sample.contact_area_m2 += area[e];
+      // Folded elements: the spring lattice has no resistance to inversion, and a press that
+      // crushes the layer under the indenter can push an element through its neighbours into a
+      // softer, folded state (docs/PROBING.md, "Validity"); its force is not the tissue's.
+      for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+        if (el.inverse_mass[e] == 0) continue;
+        const double J = deformation_gradient(lattice, u, e).determinant();
+        sample.min_det_f = std::min(sample.min_det_f, J);
+        if (J <= 0) ++sample.inverted_elements;
+      }
+      press.min_det_f = std::min(press.min_det_f, sample.min_det_f);
+      if (sample.inverted_elements > 0) {
+        press.inverted = true;
+        ++out.inverted_increments;
+      }
       depths.push_back(sample.depth_m);
       forces.push_back(sample.press_force_n);
       press.samples.push_back(sample);

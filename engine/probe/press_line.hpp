@@ -21,6 +21,8 @@ struct PressSample {
   std::int64_t steps = 0;             ///< solver steps this increment took
   double residual = 0;                ///< max residual / F_ref at the end of the increment
   bool converged = false;
+  double min_det_f = 1;               ///< smallest det F over the free elements (host fit, element_measures)
+  std::int64_t inverted_elements = 0; ///< free elements with det F ≤ 0: the lattice folded, the force is void
 };
 
 struct PressResult {
@@ -30,6 +32,8 @@ struct PressResult {
   double peak_force_n = 0;            ///< press force at the full depth (N)
   double stiffness_n_m = 0;           ///< slope of the last increment (N/m)
   std::vector<double> depth_at_force_m;  ///< per [probe] at_force: depth (m), NaN when not reached
+  double min_det_f = 1;               ///< smallest det F over the press's increments
+  bool inverted = false;              ///< some increment folded an element (det F ≤ 0): not a valid press
 };
 
 struct ProbeResult {
@@ -39,6 +43,7 @@ struct ProbeResult {
   double settle_max_displacement_m = 0;
   std::vector<PressResult> presses;
   std::int64_t unconverged_increments = 0;
+  std::int64_t inverted_increments = 0;  ///< increments that ended with an element folded (det F ≤ 0)
   std::int64_t total_steps = 0;
   double wall_time_s = 0;
 };

@@ -121,6 +121,7 @@ struct IndenterSpec {
   enum class Contact { Push, Slide, Stick };
   Kind kind = Kind::Sphere;
   Contact contact = Contact::Push;
+  double friction = 0;               ///< Coulomb coefficient μ of push contact (0: frictionless)
   double radius_m = 0;               ///< sphere, cylinder, capsule radius (m)
   double length_m = 0;               ///< capsule: length of its axis segment (m)
   /// sphere centre / a point on the plate / centre of the cylinder's flat end / the capsule's tip

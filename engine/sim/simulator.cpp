@@ -216,12 +216,15 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     volume_wg_ = wide ? kVolumeGpuWorkGroup : std::size_t(kCheckWorkGroup);
     options += " -DVB_VOLUME_WG=" + std::to_string(volume_wg_);
   }
-  const bool friction = std::any_of(scene.tori.begin(), scene.tori.end(), [](const TorusSpec& t) { return t.friction > 0; });
+  const bool friction = std::any_of(scene.tori.begin(), scene.tori.end(), [](const TorusSpec& t) { return t.friction > 0; }) ||
+                        std::any_of(scene.indenters.begin(), scene.indenters.end(),
+                                    [](const IndenterSpec& i) { return i.friction > 0; });
   options += " -DVB_TORI=" + std::to_string(scene.tori.size());
   options += " -DVB_TORUS_BASE=" + std::to_string(torus_table_base());
   options += " -DVB_FRICTION=" + std::to_string(friction);
   options += " -DVB_REST_OFFSET=" + std::to_string(rest_offsets_);
-  std::vector<std::string> sources = {"common.cl", "hyperelastic.cl", "lattice_forces.cl", "device_contact.cl",
+  // device_contact.cl first: the indenters' friction reuses its grip helpers.
+  std::vector<std::string> sources = {"common.cl", "hyperelastic.cl", "device_contact.cl", "lattice_forces.cl",
                                       "integrate.cl"};
   if (volume_) sources.push_back("volume.cl");
   if (relax_) sources.push_back("relax.cl");
@@ -568,6 +571,7 @@ std::vector<double> Simulator::indenter_row(std::size_t i) const {
   row[14] = double(int(ind.kind));     // 0 sphere, 1 plate, 2 cylinder, 3 capsule
   row[15] = ind.length_m;
   row[16] = m.t0_s;
+  row[17] = ind.friction;  // Coulomb μ (push contact)
   return row;
 }
 

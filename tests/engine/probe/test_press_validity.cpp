@@ -1,0 +1,72 @@
+// A press that folds the lattice must say so (docs/PROBING.md, "Validity"). The 2 mm palpation
+// sweep on the GPU reported forces below the tumour-free baseline over a tumour's edge: the 16 mm
+// ball pressed 4 mm (two spacings) crushed the surface layer between itself and the stiff
+// tumour until the surface element under it was pushed through the element below (det F < 0).
+// The spring lattice has no resistance to inversion, so the folded state is softer: the last
+// increment's force rise halves and the ball sinks into the fold. This reproduces it on a small
+// block: 8 mm of soft tissue (500 Pa) over a stiff (10 kPa) inclusion, h = 2 mm.
+#include <gtest/gtest.h>
+
+#include "tests/engine/probe/probe_fixtures.hpp"
+
+namespace vb {
+namespace {
+
+constexpr double kH = 0.002;
+
+Scene block_over_inclusion(bool inclusion, double depth_m, int steps) {
+  Scene s = test::probe_block(13, 13, 10, kH, 500);  // 26 × 26 × 20 mm
+  s.model.shapes[0].label = "adipose";
+  s.materials.clear();
+  s.materials["adipose"] = test::material("adipose", 500, 950);
+  if (inclusion) {
+    ShapeSpec t;
+    t.kind = ShapeSpec::Kind::Sphere;
+    t.center_m = Vec3(0.013, 0.013, 0.002);  // top 8 mm below the surface, under the press column
+    t.radius_m = 0.010;
+    t.label = "tumour";
+    s.model.shapes.push_back(t);
+    s.materials["tumour"] = test::material("tumour", 10000, 1050);
+  }
+  s.solver.precision = Precision::Float;
+  s.stop.equilibrium = 1e-5;
+  IndenterSpec finger;
+  finger.kind = IndenterSpec::Kind::Sphere;
+  finger.radius_m = 0.008;
+  s.indenters.push_back(finger);
+  s.probe = test::press_at(0.013, 0.013, depth_m, steps);
+  return s;
+}
+
+TEST(Probing, PressThatFoldsTheLatticeIsFlagged) {
+  const ProbeResult deep = test::run_probe(block_over_inclusion(true, 2 * kH, 4));
+  const PressResult& p = deep.presses.at(0);
+  for (const PressSample& s : p.samples)
+    std::printf("depth %.1f mm  F %.5g N  contact %lld  min det F %.3f  folded %lld\n", 1e3 * s.depth_m, s.press_force_n,
+                (long long)s.contact_elements, s.min_det_f, (long long)s.inverted_elements);
+  EXPECT_TRUE(p.inverted) << "the last increment folds the surface layer";
+  EXPECT_LE(p.min_det_f, 0);
+  EXPECT_GE(deep.inverted_increments, 1);
+  EXPECT_GT(p.samples.back().inverted_elements, 0);
+  // The symptom: the folded state is softer, the force's rise over the last increment drops.
+  const auto rise = [&](std::size_t j) { return p.samples[j].press_force_n - p.samples[j - 1].press_force_n; };
+  EXPECT_LT(rise(4), 0.75 * rise(3));
+  EXPECT_FALSE(p.samples[2].inverted_elements > 0) << "half as deep, nothing folds";
+}
+
+TEST(Probing, ShallowPressOverInclusionStaysValidAndStiffer) {
+  // Pressed one spacing deep the lattice stays unfolded, and the inclusion makes it stiffer.
+  const ProbeResult with = test::run_probe(block_over_inclusion(true, kH, 2));
+  const ProbeResult without = test::run_probe(block_over_inclusion(false, kH, 2));
+  const PressResult &a = with.presses.at(0), &b = without.presses.at(0);
+  std::printf("1 spacing deep: F %.5g N over the inclusion, %.5g N without; min det F %.3f, %.3f\n", a.peak_force_n,
+              b.peak_force_n, a.min_det_f, b.min_det_f);
+  EXPECT_FALSE(a.inverted);
+  EXPECT_FALSE(b.inverted);
+  EXPECT_GT(a.min_det_f, 0.3);
+  EXPECT_GT(a.peak_force_n, b.peak_force_n);
+  for (std::size_t j = 1; j < a.samples.size(); ++j) EXPECT_GT(a.samples[j].press_force_n, b.samples[j].press_force_n);
+}
+
+}  // namespace
+}  // namespace vb
