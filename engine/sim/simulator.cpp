@@ -207,8 +207,11 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_CHECK_WG=" + std::to_string(kCheckWorkGroup);
   options += " -DVB_VOLUME=" + std::to_string(volume_);
   if (volume_) {
-    // A projection is one launch (volume_project) unless VOXBREAST_VOLUME_LAUNCHES=2 asks for the
-    // two-launch form (volume_partials, volume_apply), kept to compare the two on a device.
+    // A projection is two launches on GPUs (volume_partials, volume_apply) and one elsewhere
+    // (volume_project). On an H200 the one-launch form's last work-group, applying the projection
+    // alone, took 21.8 µs against 7.9 + 10.8 µs for the two launches (docs/PERF_NOTES.md); on PoCL
+    // the two cost the same. VOXBREAST_VOLUME_LAUNCHES=1|2 overrides, to compare them on a device.
+    volume_launches_ = cl.info.is_gpu ? 2 : 1;
     if (const char* env = std::getenv("VOXBREAST_VOLUME_LAUNCHES")) volume_launches_ = std::atoi(env) == 2 ? 2 : 1;
     const bool wide = cl.info.is_gpu &&
                       cl.info.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>() >= kVolumeGpuWorkGroup &&
