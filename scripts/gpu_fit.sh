@@ -29,21 +29,7 @@ fi
 vb phantom --out "$out/ph" --spacing "$spacing" --tumour idc,15,-20,5,10 >/dev/null
 write_scene() {  # file, precision, batch
   cat >"$1" <<TOML
-[model]
-image = "ct.nii.gz"
-labels = "labels.nii.gz"
-keep = ["skin", "adipose", "fibroglandular", "muscle", "tumour"]
-[model.label_table]
-1 = "skin"
-2 = "adipose"
-3 = "fibroglandular"
-4 = "muscle"
-5 = "bone"
-6 = "tumour"
-[materials.muscle]
-rigid = true
-[materials.skin]
-E = 40000.0
+$(cat "$root/data-samples/phantom/fit_model.toml")
 [solver]
 integrator = "relaxation"
 precision = "$2"

@@ -26,21 +26,7 @@ scene() {  # file, tumour E, law, [fit] observation + extra lines, adipose E, gl
   local law_line=""
   [[ $3 == neo-hookean ]] && law_line='law = "neo-hookean"'
   cat >"$1" <<TOML
-[model]
-image = "ct.nii.gz"
-labels = "labels.nii.gz"
-keep = ["skin", "adipose", "fibroglandular", "muscle", "tumour"]
-[model.label_table]
-1 = "skin"
-2 = "adipose"
-3 = "fibroglandular"
-4 = "muscle"
-5 = "bone"
-6 = "tumour"
-[materials.muscle]
-rigid = true
-[materials.skin]
-E = 40000.0
+$(cat "$(dirname "$0")/../data-samples/phantom/fit_model.toml")
 [materials.tumour]
 $law_line
 E = $2

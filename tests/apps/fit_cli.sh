@@ -30,21 +30,7 @@ check() {  # name, python condition on the summary d
 "$bin" phantom --out "$work/ph" --spacing 6 --tumour dcis,10,-25,5,9 >/dev/null || { fail "phantom"; exit 1; }
 scene() {  # name, tumour law block, observation file, extra [fit] lines
   cat >"$work/ph/$1.toml" <<TOML
-[model]
-image = "ct.nii.gz"
-labels = "labels.nii.gz"
-keep = ["skin", "adipose", "fibroglandular", "muscle", "tumour"]
-[model.label_table]
-1 = "skin"
-2 = "adipose"
-3 = "fibroglandular"
-4 = "muscle"
-5 = "bone"
-6 = "tumour"
-[materials.muscle]
-rigid = true
-[materials.skin]
-E = 40000.0
+$(cat "$root/data-samples/phantom/fit_model.toml")
 $2
 [solver]
 integrator = "relaxation"
