@@ -366,21 +366,25 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   vol_scalars_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, scalar_zeros.size(),
                             scalar_zeros.data());
 
-  vol_partials_ = cl::Kernel(program_, "volume_partials");
-  set_lattice_args(vol_partials_, 2);
-  vol_partials_.setArg(kVolumeMesh + 0, vol_triangles_);
-  vol_partials_.setArg(kVolumeMesh + 1, cl_uint(volume_triangles_));
-  vol_partials_.setArg(kVolumeMesh + 2, vol_surface_);
-  vol_partials_.setArg(kVolumeMesh + 3, vol_incident_start_);
-  vol_partials_.setArg(kVolumeMesh + 4, vol_incident_);
-  vol_partials_.setArg(kVolumeMesh + 5, cl_uint(volume_surface_));
-  set_world_vector(vol_partials_, kVolumeCentre, centre);
-  vol_partials_.setArg(kVolumeCentre + 1, vol_grad_);
+  // volume_partials and volume_project take the same lattice, mesh, centre and gradient arguments
+  const auto mesh_kernel = [&](const char* name) {
+    cl::Kernel k(program_, name);
+    set_lattice_args(k, 2);
+    k.setArg(kVolumeMesh + 0, vol_triangles_);
+    k.setArg(kVolumeMesh + 1, cl_uint(volume_triangles_));
+    k.setArg(kVolumeMesh + 2, vol_surface_);
+    k.setArg(kVolumeMesh + 3, vol_incident_start_);
+    k.setArg(kVolumeMesh + 4, vol_incident_);
+    k.setArg(kVolumeMesh + 5, cl_uint(volume_surface_));
+    set_world_vector(k, kVolumeCentre, centre);
+    k.setArg(kVolumeCentre + 1, vol_grad_);
+    return k;
+  };
+  vol_partials_ = mesh_kernel("volume_partials");
   vol_partials_.setArg(kVolumeWithForce + 1, vol_partial_);
   vol_finish_ = cl::Kernel(program_, "volume_finish");
   vol_finish_.setArg(0, vol_partial_);
   vol_finish_.setArg(1, cl_uint(volume_groups_));
-  set_real(vol_finish_, 2, frame_sign_ * rest_volume_m3_);  // lattice frame
   vol_finish_.setArg(3, vol_scalars_);
   vol_apply_ = cl::Kernel(program_, "volume_apply");
   vol_apply_.setArg(2, vol_surface_);
@@ -389,16 +393,7 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   vol_apply_.setArg(5, vol_partial_);
   vol_apply_.setArg(6, cl_uint(volume_groups_));
   vol_apply_.setArg(kApplyRestVolume + 1, vol_scalars_);
-  vol_project_ = cl::Kernel(program_, "volume_project");
-  set_lattice_args(vol_project_, 2);
-  vol_project_.setArg(kVolumeMesh + 0, vol_triangles_);
-  vol_project_.setArg(kVolumeMesh + 1, cl_uint(volume_triangles_));
-  vol_project_.setArg(kVolumeMesh + 2, vol_surface_);
-  vol_project_.setArg(kVolumeMesh + 3, vol_incident_start_);
-  vol_project_.setArg(kVolumeMesh + 4, vol_incident_);
-  vol_project_.setArg(kVolumeMesh + 5, cl_uint(volume_surface_));
-  set_world_vector(vol_project_, kVolumeCentre, centre);
-  vol_project_.setArg(kProjectGrad, vol_grad_);
+  vol_project_ = mesh_kernel("volume_project");
   vol_project_.setArg(kProjectGrad + 1, vol_partial_);
   vol_project_.setArg(kProjectRestVolume + 1, vol_scalars_);
   vol_project_.setArg(kProjectRestVolume + 2, vol_done_);
