@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "engine/error.hpp"
+#include "engine/fit/relax_to_equilibrium.hpp"
 #include "engine/sim/reference_state.hpp"
 #include "engine/sim/run.hpp"
 #include "engine/sim/simulator.hpp"
@@ -50,20 +51,14 @@ ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice&
   out.reference_solves = int(ref.history.size());
   out.from_m.assign(3 * n, 0.0);
 
-  Scene to = scene;
-  to.output.frames_every = 0;
-  Simulator sim(to, lattice, el, cl);
+  Simulator sim(scene, lattice, el, cl);
   sim.set_rest_offsets(ref.rest_offset_m);
   const std::vector<double> still(3 * n, 0.0);
   sim.upload(warm ? warm->to_m : el.displacement_m, still);
-  sim.restart_clock();
-  const RunOutput run = run_simulation(to, lattice, el, sim);
-  require(run.summary.converged,
-          "the forward solve from the unloaded reference state stopped at " + run.summary.stop_reason + " after " +
-              std::to_string(run.summary.steps) + " steps without reaching equilibrium",
-          "fit, posture to", "raise fit.max_steps or fit.equilibrium");
-  out.to_m = run.state.displacement_m;
-  out.steps += run.summary.steps;
+  out.steps += relax_to_equilibrium(sim, scene, equilibrium_scales(lattice, el).first,
+                                    scene.gravity.acceleration_m_s2, "to");
+  std::vector<double> v;
+  sim.download(out.to_m, v);
   return out;
 }
 
