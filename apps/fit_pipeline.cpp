@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <random>
@@ -36,6 +37,13 @@ namespace {
 
 using nlohmann::json;
 
+/// JSON has no infinity: null stands for it
+json finite_or_null(const std::vector<double>& values) {
+  json out = json::array();
+  for (const double x : values) out.push_back(std::isfinite(x) ? json(x) : json());
+  return out;
+}
+
 json progress_to_json(const FitProgress& p) {
   json rows = json::array();
   for (const FitIteration& r : p.history)
@@ -44,7 +52,8 @@ json progress_to_json(const FitProgress& p) {
                     {"forward_solves", r.forward_solves}, {"wall_time_s", r.wall_time_s},
                     {"modulus_pa", r.modulus_pa}});
   return {{"modulus_pa", p.modulus_pa}, {"lower_log", p.lower_log}, {"upper_log", p.upper_log},
-          {"lm_damping", p.lm_damping}, {"history", rows}, {"finished", p.finished}, {"stop_reason", p.stop_reason}};
+          {"lm_damping", p.lm_damping}, {"history", rows}, {"finished", p.finished}, {"stop_reason", p.stop_reason},
+          {"log_standard_error", finite_or_null(p.log_standard_error)}};
 }
 
 FitProgress progress_from_json(const json& j) {
@@ -55,6 +64,9 @@ FitProgress progress_from_json(const json& j) {
   p.lm_damping = j.at("lm_damping").get<double>();
   p.finished = j.at("finished").get<bool>();
   p.stop_reason = j.at("stop_reason").get<std::string>();
+  if (j.contains("log_standard_error"))
+    for (const json& x : j.at("log_standard_error"))
+      p.log_standard_error.push_back(x.is_null() ? std::numeric_limits<double>::infinity() : x.get<double>());
   for (const json& r : j.at("history")) {
     FitIteration row;
     row.iteration = r.at("iteration");
@@ -325,10 +337,12 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
   }
   write_element_map(dir + "/residual_mm.nii.gz", model.lattice, residual_mm);
 
-  std::string regions_text = csv_line({"region", "elements", "initial_E_pa", "fitted_E_pa"});
+  // relative_standard_error: the Cramér–Rao bound of ln E (empty without a Jacobian; inf: undetermined)
+  std::string regions_text = csv_line({"region", "elements", "initial_E_pa", "fitted_E_pa", "relative_standard_error"});
   for (std::size_t r = 0; r < regions.size(); ++r)
     regions_text += csv_line({regions.names[r], std::to_string(regions.element_count[r]),
-                              shortest_number_text(problem.initial_pa[r]), shortest_number_text(E[r])});
+                              shortest_number_text(problem.initial_pa[r]), shortest_number_text(E[r]),
+                              r < progress.log_standard_error.size() ? shortest_number_text(progress.log_standard_error[r]) : ""});
   write_text_atomically(dir + "/regions.csv", regions_text);
 
   const FitIteration& first = progress.history.front();
@@ -336,8 +350,14 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
   json regions_json = json::object();
   if (regions.size() <= 64)
     for (std::size_t r = 0; r < regions.size(); ++r)
+    {
       regions_json[regions.names[r]] = {{"elements", regions.element_count[r]}, {"initial_E_pa", problem.initial_pa[r]},
                                         {"fitted_E_pa", E[r]}};
+      if (r < progress.log_standard_error.size()) {  // Cramér–Rao bound (Gauss-Newton's last Jacobian)
+        const double se = progress.log_standard_error[r];
+        regions_json[regions.names[r]]["relative_standard_error"] = std::isfinite(se) ? json(se) : json();
+      }
+    }
   json summary = {
       {"finished", true},
       {"scene", scene.source_path},
@@ -364,6 +384,13 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
                  {"p95_mm", stats.p95_m * 1e3}, {"max_mm", stats.max_m * 1e3}, {"within_1mm", stats.within_1mm}}},
       {"modulus_pa", regions_json},
   };
+  {  // where the Jacobians' time went (docs/FIT.md, "Batched solves")
+    const JacobianTiming& t = forward.jacobian_timing();
+    summary["jacobian_timing"] = {{"jacobians", t.jacobians}, {"columns", t.columns}, {"simulators", t.simulators},
+                                  {"setup_s", t.setup_s}, {"upload_s", t.upload_s}, {"relax_s", t.relax_s},
+                                  {"readback_s", t.readback_s}, {"steps", t.steps}, {"element_steps", t.element_steps},
+                                  {"most_steps_per_simulator", t.most_column_steps}};
+  }
   if (forward.unloaded_reference())  // the fixed point's relaxation solves, all forward solves together
     summary["reference_state_solves"] = forward.reference_solves();
   if (surface) {

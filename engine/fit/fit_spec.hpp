@@ -52,7 +52,7 @@ struct FitSpec {
   double equilibrium = 0;
   std::int64_t max_steps = 50000;  ///< per forward solve and posture
   /// model copies one simulator relaxes together for the Jacobian's perturbed solves (docs/FIT.md,
-  /// "Batched solves"); 0: as many as device memory and tissue ids allow; 1: one at a time
+  /// "Batched solves"); 0 (auto): one at a time, as 1 (batches lost on PoCL and an H200); N: N copies
   int batch = 0;
 
   /// solve from the unloaded reference state ([reference_state]): rest offsets re-estimated per
