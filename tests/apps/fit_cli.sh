@@ -75,6 +75,11 @@ accuracy)
   s="$work/noisy/summary.json"
   echo "     0.5 mm noise: tumour $(json "$s" "round(d['modulus_pa']['tumour']['fitted_E_pa'])") Pa, truth RMS $(json "$s" "round(d['truth']['rms_mm'], 4)") mm"
   check "0.5 mm noise: >= 99% of elements within 1 mm of the truth" "$s" "d['truth']['within_1mm'] >= 0.99"
+  echo "     Cramér–Rao standard errors: $(json "$s" "', '.join(f\"{k} {100 * v['relative_standard_error']:.1f}%\" for k, v in d['modulus_pa'].items())")"
+  check "0.5 mm noise: Cramér–Rao standard error per region, every modulus within 3 of them" "$s" \
+    "all(0 < v['relative_standard_error'] < 10 and abs(math.log(v['fitted_E_pa'] / T)) <= 3 * v['relative_standard_error'] for v, T in ((d['modulus_pa']['adipose'], 3250), (d['modulus_pa']['fibroglandular'], 6000), (d['modulus_pa']['tumour'], 16400)))"
+  check "0.5 mm noise: the 15-element tumour's bound exceeds 10% (a data limit), the bulk tissues' does not" "$s" \
+    "d['modulus_pa']['tumour']['relative_standard_error'] > 0.10 and d['modulus_pa']['adipose']['relative_standard_error'] < 0.10"
 
   nh='[materials.tumour]
 law = "neo-hookean"
