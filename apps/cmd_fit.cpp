@@ -14,8 +14,9 @@ namespace vb::app {
 namespace {
 
 struct FitCommandOptions {
-  std::string scene, out, device, precision, truth, make_observation, make_labels, cases, devices;
+  std::string scene, out, device, precision, truth, make_observation, make_labels, make_surface, cases, devices;
   int labels_subdivide = 3;
+  int surface_label = 0;
   bool retry_failed = false;
   double noise_mm = 0;
   std::uint64_t seed = 1;
@@ -39,9 +40,16 @@ int run_fit_command(const FitCommandOptions& o) {
   }
   require(!o.scene.empty(), "a scene file (or --cases) is needed", "voxbreast fit", "voxbreast fit SCENE.toml --out DIR");
   const Scene scene = load_scene(o.scene, o.precision);
-  require(!o.out.empty() || !o.make_observation.empty() || !o.make_labels.empty(), "--out is required", "voxbreast fit",
+  require(!o.out.empty() || !o.make_observation.empty() || !o.make_labels.empty() || !o.make_surface.empty(),
+          "--out is required", "voxbreast fit",
           "give --out DIR");
   const ClContext cl(select_device(o.device));
+  if (!o.make_surface.empty()) {
+    const double largest = write_synthetic_surface(scene, cl, o.make_surface, o.surface_label);
+    std::printf("wrote %s: the boundary of label %d after the posture change with the scene's materials (largest %.3f mm)\n",
+                o.make_surface.c_str(), o.surface_label, largest * 1e3);
+    if (o.make_observation.empty() && o.make_labels.empty()) return 0;
+  }
   if (!o.make_labels.empty()) {
     const double largest = write_synthetic_labels(scene, cl, o.make_labels, o.labels_subdivide);
     std::printf("wrote %s: the model's labels after the posture change with the scene's materials (largest %.3f mm)\n",
@@ -96,6 +104,12 @@ Command add_fit(CLI::App& app) {
   sub->add_option("--make-observed-labels", o->make_labels,
                   "instead of fitting: write the model's labels after the posture change with the scene's materials "
                   "(NIfTI label map, for fit.observed_labels; validation)");
+  sub->add_option("--make-observed-surface", o->make_surface,
+                  "instead of fitting: write the boundary of a region after the posture change with the scene's "
+                  "materials (binary STL, mm, LPS; for fit.observed_surface; validation)");
+  sub->add_option("--surface-label", o->surface_label,
+                  "with --make-observed-surface: the region, 0 the body outline (default) or a label value")
+      ->check(CLI::NonNegativeNumber);
   sub->add_option("--labels-subdivide", o->labels_subdivide,
                   "with --make-observed-labels: label voxels per lattice spacing along each axis (default 3)")
       ->check(CLI::Range(1, 8));

@@ -14,6 +14,7 @@
 #include "io/fit_file.hpp"
 #include "io/scene_file.hpp"
 #include "io/scene_overrides.hpp"
+#include "io/toml_text.hpp"
 
 namespace fs = std::filesystem;
 
@@ -77,7 +78,11 @@ std::vector<BatchCase> read_cases(const std::string& text, const std::string& pa
 std::string with_absolute_paths(std::string text, const std::string& source) {
   const fs::path base = fs::path(source).parent_path();
   std::vector<std::string> keys = scene_path_keys();
-  for (const char* k : {"fit.dvf", "fit.landmarks", "fit.observed_labels", "fit.mask", "fit.sigma"}) keys.push_back(k);
+  for (const char* k : {"fit.dvf", "fit.landmarks", "fit.observed_labels", "fit.observed_surface", "fit.mask", "fit.sigma"})
+    keys.push_back(k);
+  // fit.observed_surface may be an array of files: its elements by 1-based index
+  if (const toml::array* a = parse_toml_text(text, source)["fit"]["observed_surface"].as_array())
+    for (std::size_t i = 1; i <= a->size(); ++i) keys.push_back("fit.observed_surface." + std::to_string(i));
   for (const std::string& key : keys) {
     const std::string value = scene_string_value(text, source, key);
     if (value.empty() || fs::path(value).is_absolute()) continue;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <random>
@@ -19,18 +20,29 @@
 #include "engine/fit/forward_model.hpp"
 #include "engine/fit/gauss_newton.hpp"
 #include "engine/fit/deformed_labels.hpp"
+#include "engine/fit/deformed_surface.hpp"
 #include "engine/fit/initial_guess.hpp"
+#include "engine/fit/mesh_distance.hpp"
 #include "engine/fit/surface_observation.hpp"
 #include "io/atomic_file.hpp"
 #include "io/csv_table.hpp"
 #include "io/fit_file.hpp"
 #include "io/fit_landmarks_csv.hpp"
 #include "io/nifti_io.hpp"
+#include "io/stl_file.hpp"
+#include "io/triangle_mesh_files.hpp"
 
 namespace vb::app {
 namespace {
 
 using nlohmann::json;
+
+/// JSON has no infinity: null stands for it
+json finite_or_null(const std::vector<double>& values) {
+  json out = json::array();
+  for (const double x : values) out.push_back(std::isfinite(x) ? json(x) : json());
+  return out;
+}
 
 json progress_to_json(const FitProgress& p) {
   json rows = json::array();
@@ -40,7 +52,8 @@ json progress_to_json(const FitProgress& p) {
                     {"forward_solves", r.forward_solves}, {"wall_time_s", r.wall_time_s},
                     {"modulus_pa", r.modulus_pa}});
   return {{"modulus_pa", p.modulus_pa}, {"lower_log", p.lower_log}, {"upper_log", p.upper_log},
-          {"lm_damping", p.lm_damping}, {"history", rows}, {"finished", p.finished}, {"stop_reason", p.stop_reason}};
+          {"lm_damping", p.lm_damping}, {"history", rows}, {"finished", p.finished}, {"stop_reason", p.stop_reason},
+          {"log_standard_error", finite_or_null(p.log_standard_error)}};
 }
 
 FitProgress progress_from_json(const json& j) {
@@ -51,6 +64,9 @@ FitProgress progress_from_json(const json& j) {
   p.lm_damping = j.at("lm_damping").get<double>();
   p.finished = j.at("finished").get<bool>();
   p.stop_reason = j.at("stop_reason").get<std::string>();
+  if (j.contains("log_standard_error"))
+    for (const json& x : j.at("log_standard_error"))
+      p.log_standard_error.push_back(x.is_null() ? std::numeric_limits<double>::infinity() : x.get<double>());
   for (const json& r : j.at("history")) {
     FitIteration row;
     row.iteration = r.at("iteration");
@@ -111,28 +127,49 @@ Observation load_observation(const FitSpec& fit, const Lattice& lattice) {
   return obs;
 }
 
-/// The label-map observation: boundaries of fit.observed_label_values matched by the model's faces.
-/// An empty lattice voxel counts as air (the body's outside) where the CT there is below −500 HU;
-/// outside the CT (a crop edge) it does not. Shape models: every empty voxel is air.
+/// Whether an empty lattice voxel at a world point is the body's outside: the CT there is below
+/// −500 HU; outside the CT (a crop edge) it is not. Shape models: every empty voxel is air.
+std::function<bool(const Eigen::Vector3d&)> air_test(const PreparedModel& model) {
+  if (!model.ct) return [](const Eigen::Vector3d&) { return true; };
+  const ImageVolume& ct = *model.ct;
+  const Eigen::Matrix4d to_index = ct.affine_lps_m.inverse();
+  return [&ct, to_index](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d q = (to_index * p.homogeneous()).head<3>();
+    const int i = int(std::lround(q.x())), j = int(std::lround(q.y())), k = int(std::lround(q.z()));
+    if (i < 0 || j < 0 || k < 0 || i >= ct.dims[0] || j >= ct.dims[1] || k >= ct.dims[2]) return false;
+    return ct.values[ct.linear_index(i, j, k)] < -500.0f;
+  };
+}
+
+/// The surface observation: boundaries of a label map (fit.observed_labels, regions
+/// fit.observed_label_values) or surface meshes (fit.observed_surface, one region each from
+/// fit.observed_surface_values), matched by the model's boundary faces.
 std::unique_ptr<SurfaceData> load_surface_observation(const FitSpec& fit, const Scene& scene, const PreparedModel& model) {
+  const bool meshes = !fit.observed_surface_paths.empty();
+  const std::string key = meshes ? "fit.observed_surface" : "fit.observed_labels";
   require(fit.mask_path.empty() && fit.sigma_path.empty(), "fit.mask and fit.sigma apply to displacement observations",
-          "fit.observed_labels", "leave them out; fit.sigma_mm is the surface distance uncertainty");
-  const ImageVolume labels = read_nifti(fit.observed_labels_path);
-  const std::vector<SurfaceRegion> regions = surface_regions(scene, model.lattice, fit.observed_label_values);
+          key, "leave them out; fit.sigma_mm is the surface distance uncertainty");
   std::vector<bool> free(model.lattice.element_count());
   for (std::size_t e = 0; e < free.size(); ++e) free[e] = model.elements.inverse_mass[e] != 0;
-  std::function<bool(const Eigen::Vector3d&)> is_air = [](const Eigen::Vector3d&) { return true; };
-  if (model.ct) {
-    const ImageVolume& ct = *model.ct;
-    const Eigen::Matrix4d to_index = ct.affine_lps_m.inverse();
-    is_air = [&ct, to_index](const Eigen::Vector3d& p) {
-      const Eigen::Vector3d q = (to_index * p.homogeneous()).head<3>();
-      const int i = int(std::lround(q.x())), j = int(std::lround(q.y())), k = int(std::lround(q.z()));
-      if (i < 0 || j < 0 || k < 0 || i >= ct.dims[0] || j >= ct.dims[1] || k >= ct.dims[2]) return false;
-      return ct.values[ct.linear_index(i, j, k)] < -500.0f;
-    };
+  if (!meshes) {
+    const ImageVolume labels = read_nifti(fit.observed_labels_path);
+    const std::vector<SurfaceRegion> regions = surface_regions(scene, model.lattice, fit.observed_label_values);
+    return std::make_unique<SurfaceData>(labels, model.lattice, regions, free, air_test(model), fit.sigma_m);
   }
-  return std::make_unique<SurfaceData>(labels, model.lattice, regions, free, is_air, fit.sigma_m);
+  std::vector<SurfaceRegion> regions;
+  std::vector<std::unique_ptr<SurfaceDistance>> observed;
+  for (std::size_t i = 0; i < fit.observed_surface_paths.size(); ++i) {
+    const std::vector<SurfaceRegion> one =
+        surface_regions(scene, model.lattice, {fit.observed_surface_values[i]}, "fit.observed_surface_values");
+    for (const SurfaceRegion& r : regions)
+      require(r.name != one[0].name, "two surfaces of region " + r.name, "fit.observed_surface_values",
+              "give each boundary once");
+    regions.push_back(one[0]);
+    observed.push_back(std::make_unique<MeshSignedDistance>(read_stl(fit.observed_surface_paths[i]),
+                                                            fit.observed_surface_paths[i]));
+  }
+  return std::make_unique<SurfaceData>(std::move(observed), model.lattice, regions, free, air_test(model), fit.sigma_m,
+                                       "fit.observed_surface");
 }
 
 /// The element map on the lattice's own grid (world affine of the lattice), `outside` elsewhere.
@@ -197,7 +234,7 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
   std::optional<Observation> obs;  // displacements, or
   std::unique_ptr<SurfaceData> surface;  // boundaries of a label map
   std::unique_ptr<FitData> displacements;
-  if (fit.observed_labels_path.empty()) {
+  if (fit.observed_labels_path.empty() && fit.observed_surface_paths.empty()) {
     obs = load_observation(fit, model.lattice);
     unobserve_held(*obs, model.elements);
     require(obs->observed_elements() > 0, "every observed element is held", "fit");
@@ -300,10 +337,12 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
   }
   write_element_map(dir + "/residual_mm.nii.gz", model.lattice, residual_mm);
 
-  std::string regions_text = csv_line({"region", "elements", "initial_E_pa", "fitted_E_pa"});
+  // relative_standard_error: the Cramér–Rao bound of ln E (empty without a Jacobian; inf: undetermined)
+  std::string regions_text = csv_line({"region", "elements", "initial_E_pa", "fitted_E_pa", "relative_standard_error"});
   for (std::size_t r = 0; r < regions.size(); ++r)
     regions_text += csv_line({regions.names[r], std::to_string(regions.element_count[r]),
-                              shortest_number_text(problem.initial_pa[r]), shortest_number_text(E[r])});
+                              shortest_number_text(problem.initial_pa[r]), shortest_number_text(E[r]),
+                              r < progress.log_standard_error.size() ? shortest_number_text(progress.log_standard_error[r]) : ""});
   write_text_atomically(dir + "/regions.csv", regions_text);
 
   const FitIteration& first = progress.history.front();
@@ -311,8 +350,14 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
   json regions_json = json::object();
   if (regions.size() <= 64)
     for (std::size_t r = 0; r < regions.size(); ++r)
+    {
       regions_json[regions.names[r]] = {{"elements", regions.element_count[r]}, {"initial_E_pa", problem.initial_pa[r]},
                                         {"fitted_E_pa", E[r]}};
+      if (r < progress.log_standard_error.size()) {  // Cramér–Rao bound (Gauss-Newton's last Jacobian)
+        const double se = progress.log_standard_error[r];
+        regions_json[regions.names[r]]["relative_standard_error"] = std::isfinite(se) ? json(se) : json();
+      }
+    }
   json summary = {
       {"finished", true},
       {"scene", scene.source_path},
@@ -339,13 +384,23 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
                  {"p95_mm", stats.p95_m * 1e3}, {"max_mm", stats.max_m * 1e3}, {"within_1mm", stats.within_1mm}}},
       {"modulus_pa", regions_json},
   };
+  {  // where the Jacobians' time went (docs/FIT.md, "Batched solves")
+    const JacobianTiming& t = forward.jacobian_timing();
+    summary["jacobian_timing"] = {{"jacobians", t.jacobians}, {"columns", t.columns}, {"simulators", t.simulators},
+                                  {"setup_s", t.setup_s}, {"upload_s", t.upload_s}, {"relax_s", t.relax_s},
+                                  {"readback_s", t.readback_s}, {"steps", t.steps}, {"element_steps", t.element_steps},
+                                  {"most_steps_per_simulator", t.most_column_steps}};
+  }
   if (forward.unloaded_reference())  // the fixed point's relaxation solves, all forward solves together
     summary["reference_state_solves"] = forward.reference_solves();
   if (surface) {
     json per_region = json::object();
     const std::vector<std::size_t> faces = surface->faces_per_region();
     for (std::size_t r = 0; r < faces.size(); ++r) per_region[surface->regions()[r].name] = faces[r];
-    summary["surface"] = {{"path", fit.observed_labels_path}, {"faces", surface->points()}, {"faces_per_region", per_region},
+    const json path = fit.observed_surface_paths.empty() ? json(fit.observed_labels_path)
+                      : fit.observed_surface_paths.size() == 1 ? json(fit.observed_surface_paths[0])
+                                                               : json(fit.observed_surface_paths);
+    summary["surface"] = {{"source", fit.observed_surface_paths.empty() ? "label map" : "surface mesh"}, {"path", path}, {"faces", surface->points()}, {"faces_per_region", per_region},
                           {"initial", {{"rms_mm", first.rms_mm}, {"max_mm", first.max_mm}, {"within_1mm", first.within_1mm}}},
                           {"final", {{"rms_mm", stats.rms_m * 1e3}, {"mean_mm", stats.mean_m * 1e3}, {"p95_mm", stats.p95_m * 1e3},
                                      {"max_mm", stats.max_m * 1e3}, {"within_1mm", stats.within_1mm}}}};
@@ -389,6 +444,22 @@ double write_synthetic_labels(const Scene& scene, const ClContext& cl, const std
   write_nifti(path, labels, largest_value < 256 ? NiftiType::UInt8 : NiftiType::Int16);
   double largest = 0;
   for (std::size_t e = 0; e < lattice.element_count(); ++e)
+    largest = std::max(largest, std::hypot(change[3 * e], change[3 * e + 1], change[3 * e + 2]));
+  return largest;
+}
+
+double write_synthetic_surface(const Scene& scene, const ClContext& cl, const std::string& path, int label_value) {
+  FitSpec fit = parse_fit_section(scene.source_text, scene.source_path);
+  fit.regions = FitSpec::Regions::Labels;
+  fit.tissues.clear();
+  const PreparedModel model = prepare_model(scene);
+  const std::vector<SurfaceRegion> region = surface_regions(scene, model.lattice, {label_value}, "--surface-label");
+  const FitRegions regions = make_fit_regions(fit, scene, model.lattice);
+  const ForwardModel forward(scene, model.lattice, regions, fit, cl);
+  const std::vector<double> change = forward.solve(moduli_from_materials(scene, model.lattice, regions)).change_m();
+  write_triangle_mesh_stl(path, deformed_boundary_mesh(model.lattice, change, region[0].tissue));
+  double largest = 0;
+  for (std::size_t e = 0; e < model.lattice.element_count(); ++e)
     largest = std::max(largest, std::hypot(change[3 * e], change[3 * e + 1], change[3 * e + 2]));
   return largest;
 }

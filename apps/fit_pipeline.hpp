@@ -40,4 +40,11 @@ double write_synthetic_observation(const Scene& scene, const ClContext& cl, cons
 /// largest displacement (m).
 double write_synthetic_labels(const Scene& scene, const ClContext& cl, const std::string& path, int subdivide);
 
+/// Writes the boundary of one region (label value `label_value`: 0 the body outline, as
+/// fit.observed_surface_values) after the scene's posture change with its own materials as a
+/// binary STL (the observation of a surface-mesh fit's validation, fit.observed_surface): the
+/// voxel faces of the region, their corners moved by the displacement interpolated there.
+/// Returns the largest displacement (m).
+double write_synthetic_surface(const Scene& scene, const ClContext& cl, const std::string& path, int label_value);
+
 }  // namespace vb::app

@@ -15,7 +15,7 @@ const std::vector<std::string_view> kKeys = {
     "from_posture", "from_gravity", "dvf", "landmarks", "mask", "sigma", "sigma_mm", "regions", "block_mm",
     "tissues", "min_E", "max_E", "initial", "method", "max_iterations", "regularisation", "step_log",
     "tolerance", "equilibrium", "max_steps", "batch", "observed_labels", "observed_label_values",
-    "unloaded_reference"};
+    "observed_surface", "observed_surface_values", "unloaded_reference"};
 
 class FitTable {
  public:
@@ -147,11 +147,29 @@ FitSpec parse_fit_section(const std::string& scene_text, const std::string& scen
   f.mask_path = resolved(t.text("mask").value_or(""), scene_path);
   f.sigma_path = resolved(t.text("sigma").value_or(""), scene_path);
   f.observed_labels_path = resolved(t.text("observed_labels").value_or(""), scene_path);
-  if (f.dvf_path.empty() && f.landmarks_path.empty() && f.observed_labels_path.empty())
-    t.fail("dvf", "[fit] needs an observation: 'dvf' (NIfTI displacement field), 'landmarks' (CSV) or "
-                  "'observed_labels' (label map of the observed posture)");
-  if (!f.observed_labels_path.empty() && !(f.dvf_path.empty() && f.landmarks_path.empty()))
-    t.fail("observed_labels", "give one kind of observation: displacements ('dvf', 'landmarks') or 'observed_labels'");
+  if (table->get("observed_surface")) {  // one STL, or several (one per boundary)
+    if (const auto one = table->get("observed_surface")->as_string()) f.observed_surface_paths = {one->get()};
+    else f.observed_surface_paths = t.strings("observed_surface").value_or(std::vector<std::string>{});
+    if (f.observed_surface_paths.empty()) t.fail("observed_surface", "expected an STL file or an array of them");
+    for (std::string& p : f.observed_surface_paths) p = resolved(p, scene_path);
+  }
+  const int kinds = int(!(f.dvf_path.empty() && f.landmarks_path.empty())) + int(!f.observed_labels_path.empty()) +
+                    int(!f.observed_surface_paths.empty());
+  if (kinds == 0)
+    t.fail("dvf", "[fit] needs an observation: 'dvf' (NIfTI displacement field), 'landmarks' (CSV), "
+                  "'observed_labels' (label map of the observed posture) or 'observed_surface' (STL)");
+  if (kinds > 1)
+    t.fail(f.observed_surface_paths.empty() ? "observed_labels" : "observed_surface",
+           "give one kind of observation: displacements ('dvf', 'landmarks'), 'observed_labels' or 'observed_surface'");
+  if (const auto v = t.integers("observed_surface_values", 0)) {
+    if (f.observed_surface_paths.empty()) t.fail("observed_surface_values", "applies only with 'observed_surface'");
+    f.observed_surface_values = *v;
+  } else if (f.observed_surface_paths.size() == 1) {
+    f.observed_surface_values = {0};  // one surface: the body outline
+  }
+  if (f.observed_surface_values.size() != f.observed_surface_paths.size())
+    t.fail("observed_surface_values", "give one value per surface in 'observed_surface' (0: the body outline, "
+                                      "v: the boundary of the region of label v)");
   if (const auto v = t.integers("observed_label_values", 0)) {
     if (f.observed_labels_path.empty()) t.fail("observed_label_values", "applies only with 'observed_labels'");
     f.observed_label_values = *v;

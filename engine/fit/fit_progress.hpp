@@ -30,6 +30,10 @@ struct FitProgress {
   std::vector<double> state_from_m, state_to_m;
   std::vector<double> state_rest_m;  ///< its rest offsets (fit.unloaded_reference; else empty)
   std::vector<FitIteration> history;
+  /// Cramér–Rao bound of each region's ln E from the last Jacobian (Gauss-Newton): the standard
+  /// error √[(Σ_rows w ∂d/∂θ ∂d/∂θᵀ)⁻¹]_rr with noise of the fit's σ; +inf where the data do not
+  /// determine the region (singular information); empty before the first Jacobian
+  std::vector<double> log_standard_error;
   bool finished = false;
   std::string stop_reason;
 };

@@ -22,6 +22,10 @@ struct FitSpec {
   std::string observed_labels_path;
   /// which boundaries count: 0 the body outline, v > 0 the region of label v (empty: body + tumours)
   std::vector<int> observed_label_values;
+  /// surface meshes (STL, mm, LPS) of boundaries in the observed posture, matched like a label map's
+  std::vector<std::string> observed_surface_paths;
+  /// which boundary each surface is: 0 the body outline, v > 0 the region of label v (one file: {0})
+  std::vector<int> observed_surface_values;
   std::string mask_path;       ///< NIfTI: elements where it is 0 are not observed
   std::string sigma_path;      ///< NIfTI: per-point displacement uncertainty (mm)
   double sigma_m = 0.001;      ///< uncertainty of an observed displacement component (m)
@@ -48,7 +52,7 @@ struct FitSpec {
   double equilibrium = 0;
   std::int64_t max_steps = 50000;  ///< per forward solve and posture
   /// model copies one simulator relaxes together for the Jacobian's perturbed solves (docs/FIT.md,
-  /// "Batched solves"); 0: as many as device memory and tissue ids allow; 1: one at a time
+  /// "Batched solves"); 0 (auto): one at a time, as 1 (batches lost on PoCL and an H200); N: N copies
   int batch = 0;
 
   /// solve from the unloaded reference state ([reference_state]): rest offsets re-estimated per

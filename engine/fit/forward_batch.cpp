@@ -63,7 +63,6 @@ std::vector<double> block(const std::vector<double>& state, std::size_t k, std::
 std::size_t ForwardModel::batch_size() const {
   if (fit_.batch == 1 || unloaded_ || scene_.volume.preserve || scene_.reference_state.active) return 1;
   const Lattice& lat = lattice();
-  const std::size_t n = lat.element_count();
   bool hyper = false;  // as make_element_arrays decides: a tissue table row per copy
   for (const std::string& t : lat.tissue_names) {
     const MaterialSpec& m = scene_.materials.at(t);
@@ -77,25 +76,26 @@ std::size_t ForwardModel::batch_size() const {
             "fit.batch", "use batch = " + std::to_string(most) + " or \"auto\"");
     return std::size_t(fit_.batch);
   }
-  // auto on a CPU device: one at a time. A CPU is throughput-bound at any model size, so a
-  // batch saves only the per-solve setup, while every copy runs as many steps as the slowest
-  // (K·max instead of Σ steps: ~10–30% more element-steps for Jacobian columns; docs/FIT.md).
-  if (!cl_.info.is_gpu) return 1;
-  // auto on a GPU: half the device's memory (the rest for other work), and the largest buffers
-  const std::size_t real = scene_.solver.precision == Precision::Double ? 8 : 4;
-  const std::size_t cells = std::size_t(lat.dims[0] + 2) * std::size_t(lat.dims[1] + 2) * std::size_t(lat.dims[2] + 1);
-  const std::size_t per_copy =
-      estimated_device_bytes(n, cells, scene_.solver.precision, hyper) + 9 * n * real;  // + relaxation buffers
-  const DeviceInfo& d = cl_.info;
-  most = std::min(most, std::size_t(0.5 * double(d.global_memory_bytes) / double(per_copy)));
-  most = std::min(most, d.max_allocation_bytes / ((hyper ? 3 : 1) * 4 * real * n));
-  most = std::min(most, d.max_allocation_bytes / (cells * sizeof(cl_int)));
-  return std::max<std::size_t>(1, most);
+  // auto: one at a time on every device. Measured (docs/FIT.md, "Batched solves"): a batch runs
+  // every copy for as many steps as its slowest (K·max instead of Σ steps: 23% more element-steps
+  // on the 38.7k-element phantom), and it was slower per Jacobian on PoCL (+12%) and on an H200
+  // (0.63 against 0.38 s). It saves only simulator setup, which is 3% of a sequential Jacobian
+  // (summary.json jacobian_timing). Batches stay available as fit.batch = N.
+  return 1;
 }
 
 std::vector<ForwardSolution> ForwardModel::solve_batch(const std::vector<std::vector<double>>& moduli,
                                                        const ForwardSolution* warm) const {
-  const auto start = std::chrono::steady_clock::now();
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  auto mark = start;
+  const auto lap = [&](double JacobianTiming::*phase) {  // time since the last lap into `phase`
+    const auto now = Clock::now();
+    timing_.*phase += std::chrono::duration<double>(now - mark).count();
+    mark = now;
+  };
+  ++timing_.jacobians;
+  timing_.columns += moduli.size();
   std::vector<ForwardSolution> out;
   out.reserve(moduli.size());
   const std::size_t most = batch_size();
@@ -104,7 +104,8 @@ std::vector<ForwardSolution> ForwardModel::solve_batch(const std::vector<std::ve
   for (std::size_t first = 0; first < moduli.size(); first += most) {
     const std::size_t K = std::min(most, moduli.size() - first);
     if (K == 1) {
-      out.push_back(solve(moduli[first], warm));
+      out.push_back(solve_timed(moduli[first], warm, &timing_));
+      mark = Clock::now();
       continue;
     }
     std::vector<ElementArrays> parts;
@@ -119,18 +120,29 @@ std::vector<ForwardSolution> ForwardModel::solve_batch(const std::vector<std::ve
     parts.clear();
     Simulator sim(scene_, tiled, el, cl_);
     solves_ += K;
+    ++timing_.simulators;
     const std::vector<double> zeros(3 * n * K, 0.0);
+    lap(&JacobianTiming::setup_s);
     std::vector<double> from(3 * n * K, 0.0), to, v;
     std::int64_t steps = 0;
     if (fit_.from_gravity_m_s2) {
       if (warm) sim.upload(repeated(warm->from_m, K), zeros);
+      lap(&JacobianTiming::upload_s);
       steps += relax_to_equilibrium(sim, scene_, F_ref, *fit_.from_gravity_m_s2, "from");
+      lap(&JacobianTiming::relax_s);
       sim.download(from, v);
+      lap(&JacobianTiming::readback_s);
     }
     if (warm) sim.upload(repeated(warm->to_m, K), zeros);
     else if (fit_.from_gravity_m_s2) sim.upload(from, zeros);
+    lap(&JacobianTiming::upload_s);
     steps += relax_to_equilibrium(sim, scene_, F_ref, scene_.gravity.acceleration_m_s2, "to");
+    lap(&JacobianTiming::relax_s);
     sim.download(to, v);
+    lap(&JacobianTiming::readback_s);
+    timing_.steps += steps;
+    timing_.element_steps += double(steps) * double(n * K);
+    timing_.most_column_steps = std::max(timing_.most_column_steps, steps);
     for (std::size_t k = 0; k < K; ++k) {
       ForwardSolution s;
       s.from_m = block(from, k, n);
@@ -139,7 +151,7 @@ std::vector<ForwardSolution> ForwardModel::solve_batch(const std::vector<std::ve
       out.push_back(std::move(s));
     }
   }
-  batch_wall_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  batch_wall_s_ += std::chrono::duration<double>(Clock::now() - start).count();
   return out;
 }
 

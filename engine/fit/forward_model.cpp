@@ -1,5 +1,7 @@
 #include "engine/fit/forward_model.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 
@@ -104,31 +106,56 @@ std::vector<double> ForwardModel::element_modulus(const std::vector<double>& E) 
 }
 
 ForwardSolution ForwardModel::solve(const std::vector<double>& E, const ForwardSolution* warm) const {
+  return solve_timed(E, warm, nullptr);
+}
+
+ForwardSolution ForwardModel::solve_timed(const std::vector<double>& E, const ForwardSolution* warm,
+                                          JacobianTiming* timing) const {
+  using Clock = std::chrono::steady_clock;
+  auto mark = Clock::now();
+  const auto lap = [&](double JacobianTiming::*phase) {  // time since the last lap into `phase`
+    const auto now = Clock::now();
+    if (timing) timing->*phase += std::chrono::duration<double>(now - mark).count();
+    mark = now;
+  };
   const ElementArrays el = arrays(E);
   const Lattice& lat = lattice();
   ++solves_;
-  if (unloaded_) {
+  if (unloaded_) {  // the fixed point's solves: all of it counts as relaxation
     ForwardSolution out = solve_from_unloaded_reference(scene_, lat, el, cl_, warm);
     reference_solves_ += std::size_t(out.reference_solves);
+    lap(&JacobianTiming::relax_s);
     return out;
   }
   Simulator sim(scene_, lat, el, cl_);
   const std::size_t n = lat.element_count();
   const std::vector<double> zeros(3 * n, 0.0);
   const double F_ref = equilibrium_scales(lat, el).first;
+  lap(&JacobianTiming::setup_s);
   ForwardSolution out;
   out.from_m = zeros;
+  std::vector<double> v;
   if (fit_.from_gravity_m_s2) {
     if (warm) sim.upload(warm->from_m, zeros);
+    lap(&JacobianTiming::upload_s);
     out.steps += relax_to_equilibrium(sim, scene_, F_ref, *fit_.from_gravity_m_s2, "from");
-    std::vector<double> v;
+    lap(&JacobianTiming::relax_s);
     sim.download(out.from_m, v);
+    lap(&JacobianTiming::readback_s);
   }
   if (warm) sim.upload(warm->to_m, zeros);
   else if (fit_.from_gravity_m_s2) sim.upload(out.from_m, zeros);
+  lap(&JacobianTiming::upload_s);
   out.steps += relax_to_equilibrium(sim, scene_, F_ref, scene_.gravity.acceleration_m_s2, "to");
-  std::vector<double> v;
+  lap(&JacobianTiming::relax_s);
   sim.download(out.to_m, v);
+  lap(&JacobianTiming::readback_s);
+  if (timing) {
+    ++timing->simulators;
+    timing->steps += out.steps;
+    timing->element_steps += double(out.steps) * double(n);
+    timing->most_column_steps = std::max(timing->most_column_steps, out.steps);
+  }
   return out;
 }
 

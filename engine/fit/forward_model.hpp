@@ -22,6 +22,22 @@ struct ForwardSolution {
   std::vector<double> change_m() const;
 };
 
+/// Where the Jacobians' perturbed solves (solve_batch) spent their time, summed over this
+/// object's calls: so a GPU run shows whether batching loses in setup, in steps or in read-back
+/// (docs/FIT.md, "Batched solves"; summary.json `jacobian_timing`).
+struct JacobianTiming {
+  std::size_t jacobians = 0;   ///< solve_batch calls
+  std::size_t columns = 0;     ///< perturbed solves
+  std::size_t simulators = 0;  ///< simulators built for them (one per batch, or per solve)
+  double setup_s = 0;    ///< element arrays, tiling and Simulator construction (buffers, kernels, model upload)
+  double upload_s = 0;   ///< warm-start state uploads
+  double relax_s = 0;    ///< relaxation steps with their convergence checks (both postures)
+  double readback_s = 0; ///< the solutions' downloads
+  std::int64_t steps = 0;      ///< relaxation steps launched (a batch's steps count once for all its copies)
+  double element_steps = 0;    ///< Σ steps × elements relaxed: the work
+  std::int64_t most_column_steps = 0;  ///< sequential: the most steps of one column; batched: of one batch
+};
+
 class ForwardModel {
  public:
   /// Copies the scene and switches it to relaxation with the fit's tolerance. Tissues with fitted
@@ -42,8 +58,8 @@ class ForwardModel {
   /// tolerance; every copy reports the batch's steps.
   std::vector<ForwardSolution> solve_batch(const std::vector<std::vector<double>>& moduli,
                                            const ForwardSolution* warm = nullptr) const;
-  /// Copies per simulator: fit.batch, or (0, auto) on a GPU as many as half its memory, its
-  /// largest buffer and the 256 tissue ids allow, on a CPU device 1; 1 with [volume] preserve or
+  /// Copies per simulator: fit.batch = N (at most the 256 tissue ids allow), or 1 for auto (0) on
+  /// every device (batches measured slower per Jacobian, docs/FIT.md); 1 with [volume] preserve or
   /// [reference_state] (their constraint and rest state are one per simulator).
   std::size_t batch_size() const;
 
@@ -55,6 +71,8 @@ class ForwardModel {
   std::size_t forward_solves() const { return solves_; }
   /// wall time spent in solve_batch (the Jacobians' perturbed solves) by this object (s)
   double batch_wall_s() const { return batch_wall_s_; }
+  /// its split into setup, uploads, relaxation and read-back, with the steps
+  const JacobianTiming& jacobian_timing() const { return timing_; }
   /// whether solves start from the unloaded reference state (reference_forward.hpp)
   bool unloaded_reference() const { return unloaded_; }
   /// relaxation solves of the unloaded reference state's fixed point, over all forward solves
@@ -62,6 +80,9 @@ class ForwardModel {
 
  private:
   ElementArrays arrays(const std::vector<double>& region_modulus_pa) const;
+  /// solve(), its phases added to `timing` when given
+  ForwardSolution solve_timed(const std::vector<double>& region_modulus_pa, const ForwardSolution* warm,
+                              JacobianTiming* timing) const;
 
   mutable Scene scene_;  ///< relaxation; split tissues' moduli change per solve
   const Lattice& lattice_;
@@ -77,6 +98,7 @@ class ForwardModel {
   std::vector<double> base_modulus_;  ///< n: E of each element's own material
   mutable std::size_t solves_ = 0;
   mutable double batch_wall_s_ = 0;
+  mutable JacobianTiming timing_;
   mutable std::size_t reference_solves_ = 0;
 };
 

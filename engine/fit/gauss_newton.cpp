@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "engine/error.hpp"
 
@@ -35,6 +36,20 @@ Eigen::VectorXd data_residual(const FitData& data, const std::vector<double>& ch
   const ResidualRows rows = data.rows(change_m);
   const double N = double(std::max<std::size_t>(1, data.points()));
   return (rows.weight_per_m2.array() / N).sqrt() * rows.value_m.array();
+}
+
+double data_points(const FitData& data) { return double(std::max<std::size_t>(1, data.points())); }
+
+/// The Cramér–Rao standard errors of ln E: J holds the rows sqrt(w/N)·∂d/∂θ, so the Fisher
+/// information of noise with the rows' σ (w = 1/σ²) is N·JᵀJ; the bound is its inverse's diagonal.
+std::vector<double> cramer_rao_log_se(const Eigen::MatrixXd& J, double N) {
+  const Eigen::MatrixXd fisher = N * (J.transpose() * J);
+  const Eigen::FullPivLU<Eigen::MatrixXd> lu(fisher);
+  std::vector<double> se(std::size_t(J.cols()), std::numeric_limits<double>::infinity());
+  if (!lu.isInvertible()) return se;
+  const Eigen::MatrixXd cov = lu.inverse();
+  for (Eigen::Index r = 0; r < J.cols(); ++r) se[std::size_t(r)] = cov(r, r) > 0 ? std::sqrt(cov(r, r)) : se[std::size_t(r)];
+  return se;
 }
 
 double regularisation_cost(const FitProblem& p, const std::vector<double>& E) {
@@ -111,6 +126,7 @@ FitProgress run_gauss_newton(const FitProblem& p, FitProgress progress, const Fi
     const std::vector<ForwardSolution> columns = model.solve_batch(perturbed, &base);
     for (std::size_t k = 0; k < R; ++k)
       J.col(Eigen::Index(k)) = (data_residual(*p.data, columns[k].change_m()) - r0) / h[k];
+    progress.log_standard_error = cramer_rao_log_se(J, data_points(*p.data));
     Eigen::VectorXd theta(static_cast<Eigen::Index>(R)), theta0(static_cast<Eigen::Index>(R));
     for (std::size_t k = 0; k < R; ++k) theta[Eigen::Index(k)] = std::log(E[k]), theta0[Eigen::Index(k)] = std::log(p.initial_pa[k]);
     const Eigen::MatrixXd H = J.transpose() * J + alpha * Eigen::MatrixXd::Identity(Eigen::Index(R), Eigen::Index(R));

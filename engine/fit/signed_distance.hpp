@@ -18,16 +18,24 @@ namespace vb {
 std::vector<double> squared_distance_transform(const std::vector<std::uint8_t>& feature, const std::array<int, 3>& dims,
                                                const Eigen::Vector3d& spacing_m);
 
+/// A signed distance to an observed surface (negative inside), at world points (LPS m): from a
+/// label map (SignedDistanceField) or a triangle mesh (MeshSignedDistance, mesh_distance.hpp).
+class SurfaceDistance {
+ public:
+  virtual ~SurfaceDistance() = default;
+  virtual double at(const Eigen::Vector3d& p_m) const = 0;
+};
+
 /// A signed distance field on an image's grid: negative inside the region, positive outside, zero
 /// on the voxel faces between them (each voxel centre's distance to the nearest centre on the
 /// other side, less half the smallest spacing).
-class SignedDistanceField {
+class SignedDistanceField final : public SurfaceDistance {
  public:
   /// `inside`: one flag per voxel of `grid` (its values are not read). Throws vb::Error when the
   /// region is empty or fills the whole grid (no boundary), naming `what`.
   SignedDistanceField(const ImageVolume& grid, const std::vector<std::uint8_t>& inside, const std::string& what);
   /// trilinear at a world point (LPS m); points outside the grid take the nearest border value
-  double at(const Eigen::Vector3d& p_m) const;
+  double at(const Eigen::Vector3d& p_m) const override;
 
  private:
   std::array<int, 3> dims_;

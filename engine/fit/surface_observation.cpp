@@ -16,7 +16,8 @@ bool is_tumour_name(const std::string& name, const Scene& scene) {
 
 }  // namespace
 
-std::vector<SurfaceRegion> surface_regions(const Scene& scene, const Lattice& lattice, const std::vector<int>& values) {
+std::vector<SurfaceRegion> surface_regions(const Scene& scene, const Lattice& lattice, const std::vector<int>& values,
+                                           const std::string& key) {
   // label values of each modelled tissue
   std::vector<std::vector<int>> values_of(lattice.tissue_names.size());
   for (std::size_t t = 0; t < lattice.tissue_names.size(); ++t) {
@@ -35,7 +36,7 @@ std::vector<SurfaceRegion> surface_regions(const Scene& scene, const Lattice& la
       if (v != 0) {
         for (std::size_t u = 0; u < values_of.size() && t < 0; ++u)
           if (std::find(values_of[u].begin(), values_of[u].end(), v) != values_of[u].end()) t = int(u);
-        require(t >= 0, "label value " + std::to_string(v) + " is no tissue of the model", "fit.observed_label_values",
+        require(t >= 0, "label value " + std::to_string(v) + " is no tissue of the model", key,
                 "use 0 for the body outline, else a label value of a modelled tissue ([model.label_table], keep)");
       }
       if (std::find(tissues.begin(), tissues.end(), t) == tissues.end()) tissues.push_back(t);
@@ -52,9 +53,7 @@ SurfaceData::SurfaceData(const ImageVolume& observed, const Lattice& lattice, co
                          const std::vector<bool>& free, const std::function<bool(const Eigen::Vector3d&)>& is_air,
                          double sigma_m)
     : regions_(regions), weight_per_m2_(1 / (sigma_m * sigma_m)) {
-  const Eigen::Matrix4d A = lattice.affine();
-  for (std::size_t r = 0; r < regions_.size(); ++r) {
-    const SurfaceRegion& region = regions_[r];
+  for (const SurfaceRegion& region : regions_) {
     std::vector<std::uint8_t> inside(observed.voxel_count());
     for (std::size_t i = 0; i < inside.size(); ++i) {
       const int v = int(std::lround(observed.values[i]));
@@ -63,6 +62,23 @@ SurfaceData::SurfaceData(const ImageVolume& observed, const Lattice& lattice, co
                       : std::find(region.label_values.begin(), region.label_values.end(), v) != region.label_values.end();
     }
     fields_.push_back(std::make_unique<SignedDistanceField>(observed, inside, "fit.observed_labels, region " + region.name));
+  }
+  collect_faces(lattice, free, is_air, "fit.observed_label_values");
+}
+
+SurfaceData::SurfaceData(std::vector<std::unique_ptr<SurfaceDistance>> observed, const Lattice& lattice,
+                         const std::vector<SurfaceRegion>& regions, const std::vector<bool>& free,
+                         const std::function<bool(const Eigen::Vector3d&)>& is_air, double sigma_m, const std::string& key)
+    : regions_(regions), fields_(std::move(observed)), weight_per_m2_(1 / (sigma_m * sigma_m)) {
+  require(fields_.size() == regions_.size(), "one observed surface per region is needed", key);
+  collect_faces(lattice, free, is_air, key);
+}
+
+void SurfaceData::collect_faces(const Lattice& lattice, const std::vector<bool>& free,
+                                const std::function<bool(const Eigen::Vector3d&)>& is_air, const std::string& key) {
+  const Eigen::Matrix4d A = lattice.affine();
+  for (std::size_t r = 0; r < regions_.size(); ++r) {
+    const SurfaceRegion& region = regions_[r];
     // the model's faces of this region: free elements with a face neighbour outside it
     std::size_t faces = 0;
     for (std::size_t e = 0; e < lattice.element_count(); ++e) {
@@ -86,7 +102,7 @@ SurfaceData::SurfaceData(const ImageVolume& observed, const Lattice& lattice, co
         ++faces;
       }
     }
-    require(faces > 0, "the model has no free boundary face of region " + region.name, "fit.observed_label_values",
+    require(faces > 0, "the model has no free boundary face of region " + region.name, key,
             "choose regions whose boundary moves (not held by anchors or rigid tissue)");
   }
 }

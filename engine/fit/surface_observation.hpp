@@ -1,5 +1,5 @@
 #pragma once
-/// Observation from a label map of the observed posture (a second CT's segmentation, docs/FIT.md
+/// Observation from a label map or surface meshes of the observed posture (a second CT's segmentation, docs/FIT.md
 /// "Observation from a label map"): the model's boundary faces, moved by the simulated posture
 /// change, should lie on the observed boundaries of the same regions. The residual of a face is
 /// its signed distance to that boundary (a distance transform of the label map, sampled
@@ -29,7 +29,9 @@ struct SurfaceRegion {
 /// stands for in the model's label table, or tissue v − 1 of a shape model). Empty `values`: the
 /// body and every tumour tissue of the model (names containing "tumour" or "tumor", and
 /// [positioning] tumour_tissue). Throws vb::Error for a value no modelled tissue has.
-std::vector<SurfaceRegion> surface_regions(const Scene& scene, const Lattice& lattice, const std::vector<int>& values);
+/// `key` names the scene key in errors.
+std::vector<SurfaceRegion> surface_regions(const Scene& scene, const Lattice& lattice, const std::vector<int>& values,
+                                           const std::string& key = "fit.observed_label_values");
 
 class SurfaceData final : public FitData {
  public:
@@ -38,6 +40,12 @@ class SurfaceData final : public FitData {
   /// Throws vb::Error when a region has no face in the model or no boundary in the label map.
   SurfaceData(const ImageVolume& observed_labels, const Lattice& lattice, const std::vector<SurfaceRegion>& regions,
               const std::vector<bool>& free, const std::function<bool(const Eigen::Vector3d&)>& is_air, double sigma_m);
+  /// The same faces against given observed surfaces, one per region (e.g. MeshSignedDistance of
+  /// surface meshes, docs/FIT.md "Observation from a surface mesh"); `key` names the scene key in
+  /// errors.
+  SurfaceData(std::vector<std::unique_ptr<SurfaceDistance>> observed, const Lattice& lattice,
+              const std::vector<SurfaceRegion>& regions, const std::vector<bool>& free,
+              const std::function<bool(const Eigen::Vector3d&)>& is_air, double sigma_m, const std::string& key);
 
   ResidualRows rows(const std::vector<double>& change_m) const override;
   std::size_t points() const override { return points_.size(); }
@@ -59,7 +67,9 @@ class SurfaceData final : public FitData {
     Eigen::Vector3d rest_m;  ///< face centre in the model's image (world, m)
   };
   std::vector<SurfaceRegion> regions_;
-  std::vector<std::unique_ptr<SignedDistanceField>> fields_;
+  void collect_faces(const Lattice& lattice, const std::vector<bool>& free,
+                     const std::function<bool(const Eigen::Vector3d&)>& is_air, const std::string& key);
+  std::vector<std::unique_ptr<SurfaceDistance>> fields_;
   std::vector<Face> points_;
   double weight_per_m2_;
 };
