@@ -32,8 +32,11 @@ inline real spring_end(int law, global const real* mat, real k, real len, real r
 // c_hg·k(|r| − |F·r₀|), whose rest length is the length its own affine fit predicts, so affine
 // fields feel no hourglass force (r₀ the connection at rest: h·d, or h·d + Δu0 with rest offsets,
 // F the element's deformation from rest).
-// u: displacement (m) with w = inverse mass (1/kg, 0 = held); v: velocity (m/s).
-real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v, VB_LATTICE_PARAMS) {
+// u: displacement (m) with w = inverse mass (1/kg, 0 = held); v: velocity (m/s). With a pending
+// volume projection (VB_PENDING_PARAMS, kernels/common.cl) the neighbours' u, v are read as the
+// projection leaves them; ui, vi are the caller's (already projected).
+real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                            VB_LATTICE_PARAMS, VB_PENDING_PARAMS) {
   const int cell = (int)cell_of[e];
   const real Ei = E[e];
   real4 f = (real4)(0);
@@ -55,7 +58,8 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
     const int jn = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
     const real present = jn >= 0 ? (real)1 : (real)0;
     const int j = jn >= 0 ? jn : (int)e;
-    const real4 uj = u[j];
+    real4 uj = u[j], wgj = (real4)(0);
+    pending_u(&uj, &wgj, (uint)j, VB_PENDING_ARGS);
     const real4 hd = (real4)(h * VB_DIR[d][0], h * VB_DIR[d][1], h * VB_DIR[d][2], 0);
     const real4 r = (real4)(hd.x + (uj.x - ui.x), hd.y + (uj.y - ui.y), hd.z + (uj.z - ui.z), 0);
     const real len_sq = dot3(r, r);
@@ -109,7 +113,9 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
     real magnitude = k * (len - rest);
 #endif
 #if VB_DASHPOT
-    magnitude += 2 * dashpot_ratio * sqrt(kE * q) * dot3(v[j] - vi, n);
+    real4 vj = v[j];
+    pending_v(&vj, wgj, VB_PENDING_ARGS);
+    magnitude += 2 * dashpot_ratio * sqrt(kE * q) * dot3(vj - vi, n);
 #endif
     f += magnitude * n;
   }
@@ -119,14 +125,24 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
   return f;
 }
 
+inline real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                           VB_LATTICE_PARAMS) {
+  return lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_NO_PENDING);
+}
+
 // Net force on a free element from the lattice and gravity (N), before contact constraints.
-inline real4 static_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                          VB_LATTICE_PARAMS) {
-  real4 f = lattice_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
+inline real4 static_force_pending(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                                  VB_LATTICE_PARAMS, VB_PENDING_PARAMS) {
+  real4 f = lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS);
 #if VB_GRAVITY
   f += xyz0(gravity) / ui.w;
 #endif
   return f;
+}
+
+inline real4 static_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                          VB_LATTICE_PARAMS) {
+  return static_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_NO_PENDING);
 }
 
 #if VB_INDENTERS
