@@ -34,9 +34,11 @@ inline real spring_end(int law, global const real* mat, real k, real len, real r
 // F the element's deformation from rest).
 // u: displacement (m) with w = inverse mass (1/kg, 0 = held); v: velocity (m/s). With a pending
 // volume projection (VB_PENDING_PARAMS, kernels/common.cl) the neighbours' u, v are read as the
-// projection leaves them; ui, vi are the caller's (already projected).
+// projection leaves them; ui, vi are the caller's (already projected). Only connections d_lo ≤ d <
+// d_hi are summed (kernels/integrate.cl, VB_SPLIT: parts of an element's connections on several
+// work-items); 0, 26 for all.
 real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                            VB_LATTICE_PARAMS, VB_PENDING_PARAMS) {
+                            VB_LATTICE_PARAMS, VB_PENDING_PARAMS, int d_lo, int d_hi) {
   const int cell = (int)cell_of[e];
   const real Ei = E[e];
   real4 f = (real4)(0);
@@ -53,6 +55,7 @@ real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, g
 #endif
 #pragma unroll
   for (int d = 0; d < 26; ++d) {
+    if (d < d_lo || d >= d_hi) continue;  // d is a constant once unrolled; the range is uniform
     // Branch-free: a missing neighbour reads the element itself and is masked out, so CPU
     // compilers can vectorise across work-items.
     const int jn = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
@@ -127,22 +130,17 @@ real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, g
 
 inline real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
                            VB_LATTICE_PARAMS) {
-  return lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_NO_PENDING);
+  return lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_NO_PENDING, 0, 26);
 }
 
 // Net force on a free element from the lattice and gravity (N), before contact constraints.
-inline real4 static_force_pending(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                                  VB_LATTICE_PARAMS, VB_PENDING_PARAMS) {
-  real4 f = lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS);
+inline real4 static_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                          VB_LATTICE_PARAMS) {
+  real4 f = lattice_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
 #if VB_GRAVITY
   f += xyz0(gravity) / ui.w;
 #endif
   return f;
-}
-
-inline real4 static_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                          VB_LATTICE_PARAMS) {
-  return static_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_NO_PENDING);
 }
 
 #if VB_INDENTERS

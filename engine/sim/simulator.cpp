@@ -18,6 +18,9 @@ constexpr int kCheckWorkGroup = 128;
 // volume_project's work-groups on GPUs (kernels/volume.cl): its last group applies the projection
 // to the whole surface, so wide groups keep that tail short
 constexpr std::size_t kVolumeGpuWorkGroup = 512;
+// VB_SPLIT (kernels/integrate.cl): work-group size of the split Heun kernels, and the model size
+// up to which GPUs split (the perf branch gained at 36k elements and lost nothing to ~100k)
+constexpr std::size_t kSplitWorkGroup = 128, kSplitMaxElements = 262144;
 constexpr int kCheckBaseSlots = 5, kCheckSlotsPerIndenter = 4;  // kernels/checks.cl
 constexpr int kCheckSlotsPerTorus = 8;                             // VB_TORUS_SLOTS
 constexpr int kIndenterStride = 20;                                // VB_IND_STRIDE
@@ -231,6 +234,21 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     options += " -DVB_VOLUME_PAIRS=" + std::to_string(volume_pairs_);
   }
   options += " -DVB_VOLUME_FOLD=" + std::to_string(volume_ && volume_launches_ == 0);
+  // Heun's force passes on GPUs with each element's connections over 2 work-items for small
+  // hyperelastic models (kernels/integrate.cl, VB_SPLIT): ~1,100 warps at 36k elements leave a
+  // latency-bound pass short of threads. VOXBREAST_FORCE_SPLIT=1|2|4 overrides, on any device.
+  const bool heun_steps = scene.solver.integrator == Integrator::Heun;
+  force_split_ = heun_steps && cl.info.is_gpu && el.hyperelastic && n_ <= kSplitMaxElements ? 2 : 1;
+  if (const char* env = std::getenv("VOXBREAST_FORCE_SPLIT")) {
+    const int k = std::atoi(env);
+    if (heun_steps && (k == 1 || k == 2 || k == 4)) force_split_ = k;
+  }
+  options += " -DVB_SPLIT=" + std::to_string(force_split_);
+  {
+    const std::size_t per = kSplitWorkGroup / std::size_t(force_split_);
+    step_global_ = force_split_ > 1 ? cl::NDRange((n_ + per - 1) / per * kSplitWorkGroup) : global_;
+    step_local_ = force_split_ > 1 ? cl::NDRange(kSplitWorkGroup) : local_;
+  }
   const bool friction = std::any_of(scene.tori.begin(), scene.tori.end(), [](const TorusSpec& t) { return t.friction > 0; }) ||
                         std::any_of(scene.indenters.begin(), scene.indenters.end(),
                                     [](const IndenterSpec& i) { return i.friction > 0; });
@@ -776,21 +794,21 @@ void Simulator::advance(std::int64_t steps) {
         // after the step.
         set_fold_args(pending_, project);
         enqueue_stress(u_, &vol_grad_, pending_ ? &vol_scalars_ : &vol_no_scalars_);
-        enqueue(predict_);
+        launch(predict_, step_global_, step_local_);
         if (project) enqueue_pending_projection(u_tmp_, v_tmp_, true);
         enqueue_stress(u_tmp_, &vol_grad_pred_, project ? &vol_scalars_pred_ : &vol_no_scalars_);
-        enqueue(correct_);
+        launch(correct_, step_global_, step_local_);
         if (project) enqueue_pending_projection(u_, v_, false);
         pending_ = project;
         continue;
       }
       enqueue_stress(u_);
-      enqueue(predict_);
+      launch(predict_, step_global_, step_local_);
       // The predicted stage is projected too: its velocity along g would otherwise reach the
       // corrector's dashpots and leave a steady slip at the constrained equilibrium.
       if (project) enqueue_volume_correction(u_tmp_, v_tmp_);
       enqueue_stress(u_tmp_);
-      enqueue(correct_);
+      launch(correct_, step_global_, step_local_);
     } else {
       cl::Kernel& k = relax_ ? relax_kernel_ : euler_;
       k.setArg(0, u_); k.setArg(1, v_); k.setArg(2, u_tmp_); k.setArg(3, v_tmp_);

@@ -139,6 +139,9 @@ class Simulator {
   /// VOXBREAST_VOLUME_LAUNCHES=0): volume_pending computes the projection and the kernels that read
   /// the state next apply it, with no apply launch (kernels/volume.cl)
   int volume_launches() const { return volume_launches_; }
+  /// work-items per element in Heun's force passes (kernels/integrate.cl, VB_SPLIT): 2 on GPUs for
+  /// hyperelastic models up to 262,144 elements, else 1; VOXBREAST_FORCE_SPLIT=1|2|4 overrides
+  int force_split() const { return force_split_; }
 
  private:
   void set_indenter_args(cl::Kernel& k, int first_arg, double t_force, double t_project);
@@ -232,7 +235,9 @@ class Simulator {
   /// applies the state's pending projection (volume_apply) before anything else reads u, v
   void apply_pending_projection() const;
   bool volume_pairs_ = true;  ///< incident triangles as element pairs (VB_VOLUME_PAIRS)
-  mutable bool pending_ = false;  ///< (u_, v_) has a projection pending (vol_grad_, vol_scalars_)
+  mutable bool pending_ = false;
+  int force_split_ = 1;
+  cl::NDRange step_global_, step_local_;  ///< Heun's stepping kernels (VB_SPLIT)  ///< (u_, v_) has a projection pending (vol_grad_, vol_scalars_)
   cl::Buffer vol_grad_pred_, vol_scalars_pred_, vol_no_scalars_;
   cl::Kernel vol_pending_;
   bool volume_ = false;
