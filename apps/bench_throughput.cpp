@@ -187,7 +187,8 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                     {"steps_per_s", sps}, {"bytes_per_element_step", bytes}, {"effective_bandwidth_gb_s", effective / 1e9},
                     {"fraction_of_copy_bandwidth", effective / bandwidth},
                     {"device_bytes_per_element", double(sim.device_bytes()) / double(n)},
-                    {"volume_launches_per_projection", c.volume ? sim.volume_launches() : 0}});
+                    {"volume_launches_per_projection", c.volume ? sim.volume_launches() : 0},
+                    {"force_split", sim.force_split()}});
     csv << c.name << "," << n << "," << c.law << "," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
         << "\n";

@@ -11,6 +11,9 @@
 //   -DVB_TORI=count, -DVB_TORUS_BASE=N, -DVB_FRICTION=0|1  the torus device (kernels/device_contact.cl)
 //   -DVB_REST_OFFSET=0|1  the rest state is not the lattice: element e rests at its voxel centre
 //                     plus rest_offset[e] (the unloaded reference state, docs/PHYSICS.md §13)
+//   -DVB_VOLUME_FOLD=0|1  Heun with the volume constraint, projections applied by the kernels that
+//                     read the state next (VB_PENDING_PARAMS below) instead of by volume_apply
+//   -DVB_VOLUME_PAIRS=0|1  the volume gradient's incident triangles as element pairs (kernels/volume.cl)
 // and prepends the lattice tables (VB_DIR, VB_DIR_LEN, VB_KAPPA) generated from the host's
 // single definition (engine/sim/kernel_tables.cpp).
 #if VB_DOUBLE
@@ -53,6 +56,24 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
 #define VB_LATTICE_ARGS \
   E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity, damping, origin, tissue_of, materials, Qs, Fs, hourglass, \
       rest_offset
+// A pending volume projection (kernels/volume.cl, VB_VOLUME_FOLD): the state in memory is the
+// unprojected (u, v), and its readers see what volume_apply would have stored,
+//   u + λ·(w·g),  v − μ·(w·g)   (g = pend_g[j], zero off the surface; w = u.w),
+// with the same operations as volume_apply_one, so the values are those of the two-launch form.
+// `pending` is a constant at every call (0: no projection; the compiler drops the loads).
+#define VB_PENDING_PARAMS global const real4 *pend_g, real pend_lambda, real pend_mu, int pending
+#define VB_PENDING_ARGS pend_g, pend_lambda, pend_mu, pending
+#define VB_NO_PENDING (global const real4*)0, (real)0, (real)0, 0
+// Element j's displacement uj as the projection leaves it; wg gets w·g (kept for its velocity).
+inline void pending_u(real4* uj, real4* wg, uint j, VB_PENDING_PARAMS) {
+  if (!pending) return;
+  *wg = uj->w * pend_g[j];
+  *uj = *uj + pend_lambda * *wg;
+}
+inline void pending_v(real4* vj, real4 wg, VB_PENDING_PARAMS) {
+  if (pending) *vj = *vj - pend_mu * wg;
+}
+
 // Rigid indenters: a table of VB_INDENTERS rows (lattice frame, VB_IND_STRIDE reals each:
 // 0–2 start (m), 3 radius (m; -1 for a plate), 4–6 plate normal into the tissue / cylinder and
 // capsule axis (unit), 8–10 velocity (m/s), 12 travel time (s), 13 contact: 0 push, 1 slide,

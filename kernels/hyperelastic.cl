@@ -238,11 +238,13 @@ inline mat3 stress_ogden(mat3 C, real J, global const real* mat) {
 
 // Least-squares deformation gradient of element e from the displacements u of its existing
 // neighbours: F = A·B⁻¹ (see the top of this file). Sets B⁻¹ (in units of 1/h²) and the bit mask
-// of present neighbours; returns false when they do not span 3-D (a thin strand: no F).
+// of present neighbours; returns false when they do not span 3-D (a thin strand: no F). u is read
+// as a pending volume projection leaves it (kernels/common.cl).
 inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_of, global const int* grid,
-                         int sy, int sz, real h, mat3* F, mat3* Bi, uint* present_out) {
+                         int sy, int sz, real h, mat3* F, mat3* Bi, uint* present_out, VB_PENDING_PARAMS) {
   const int cell = (int)cell_of[e];
-  const real4 ue = u[e];
+  real4 ue = u[e], wg = (real4)(0);
+  pending_u(&ue, &wg, e, VB_PENDING_ARGS);
   mat3 A = mat3_zero(), B = mat3_zero();  // B in units of h²
   uint present = 0;
 #pragma unroll
@@ -250,7 +252,8 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
     const int j = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
     if (j < 0) continue;
     present |= 1u << d;
-    const real4 uj = u[j];
+    real4 uj = u[j];
+    pending_u(&uj, &wg, (uint)j, VB_PENDING_ARGS);
     const real dX[3] = {VB_DIR[d][0], VB_DIR[d][1], VB_DIR[d][2]};
     const real dx[3] = {h * dX[0] + (uj.x - ue.x), h * dX[1] + (uj.y - ue.y), h * dX[2] + (uj.z - ue.z)};
     // only d's nonzero components (constants once unrolled): adding x·0 changes nothing, but the
@@ -280,17 +283,28 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
 // F₀ (rest_frame: rows of R₀ = F₀⁻¹, J₀ = det F₀ in row 0's w): the law sees F·R₀ and the energy
 // J₀·V·W(F·R₀) gives Q = J₀·V·P(F·R₀)·R₀ᵀ·B⁻¹ on the same lattice offsets. F_out is the
 // deformation from rest (F·R₀), which the hourglass control applies to the rest connections.
+// With VB_VOLUME_FOLD, u may have a volume projection pending: its gradient pend_g and scalars
+// {λ, μ, …} (all zero when none is).
 kernel void element_stress(global const real4* u, global const uchar* tissue_of, global const real* materials,
                            global const uint* cell_of, global const int* grid, int sy, int sz, real h,
-                           global real4* Q_out, global real4* F_out, uint n, global const real4* rest_frame) {
+                           global real4* Q_out, global real4* F_out, uint n, global const real4* rest_frame
+#if VB_VOLUME_FOLD
+                           , global const real4* pend_g, global const real* pend_scalars
+#endif
+) {
   const uint e = get_global_id(0);
   if (e >= n) return;
+#if VB_VOLUME_FOLD
+#define VB_STRESS_PENDING pend_g, pend_scalars[0], (real)0, 1
+#else
+#define VB_STRESS_PENDING VB_NO_PENDING
+#endif
   global const real* mat = materials + VB_MAT_STRIDE * tissue_of[e];
   const int law = (int)mat[0];
   mat3 F, Bi;
   uint present = 0;
   // spring tissue, or neighbours that do not span 3-D: no element stress
-  if (!VB_LAW_HYPER(law) || !fit_gradient(u, e, cell_of, grid, sy, sz, h, &F, &Bi, &present)) {
+  if (!VB_LAW_HYPER(law) || !fit_gradient(u, e, cell_of, grid, sy, sz, h, &F, &Bi, &present, VB_STRESS_PENDING)) {
     mat3_store(Q_out, e, mat3_zero());
     mat3_store(F_out, e, mat3_identity());
     return;
@@ -338,7 +352,7 @@ kernel void rest_frame(global const real4* u0, global const uchar* tissue_of, gl
   uint present = 0;
   real J0 = 1;
   mat3 R0 = mat3_identity();
-  if (VB_LAW_HYPER(law) && fit_gradient(u0, e, cell_of, grid, sy, sz, h, &F0, &Bi, &present)) {
+  if (VB_LAW_HYPER(law) && fit_gradient(u0, e, cell_of, grid, sy, sz, h, &F0, &Bi, &present, VB_NO_PENDING)) {
     J0 = mat3_det(F0);
     R0 = mat3_inverse(F0, J0);
   }

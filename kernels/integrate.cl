@@ -7,10 +7,14 @@
 //     corrector u' = u + dt/2·(v + ṽ), v' = v + dt/2·(a(u, v) + a(ũ, ṽ)) = (v + ṽ)/2 + dt/2·a(ũ, ṽ)
 //     (a(u, v) is recovered from ṽ, so no force buffer is stored).
 
+// Acceleration of free element e from its lattice force f (N): gravity, global damping and the
+// indenters' constraint added as static_force and acceleration add them.
 // `grip` collects the indenters' friction (device_contact.cl), turned into m/s² like the torus's.
-inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                          VB_LATTICE_PARAMS, global const real* indenters, real t, torus_grip* grip) {
-  real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
+inline real4 acceleration_from(real4 f, uint e, real4 ui, real4 vi, VB_LATTICE_PARAMS,
+                               global const real* indenters, real t, torus_grip* grip) {
+#if VB_GRAVITY
+  f += xyz0(gravity) / ui.w;
+#endif
 #if VB_GLOBAL_DAMPING
   f -= damping * xyz0(vi) / ui.w;
 #endif
@@ -19,6 +23,12 @@ inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, glo
 #endif
   grip->grip_n *= ui.w;
   return f * ui.w;
+}
+
+inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                          VB_LATTICE_PARAMS, global const real* indenters, real t, torus_grip* grip) {
+  return acceleration_from(lattice_force(e, ui, vi, u, v, VB_LATTICE_ARGS), e, ui, vi, VB_LATTICE_ARGS,
+                           indenters, t, grip);
 }
 
 // Ends a stage: moves an element that ended inside an indenter or a torus tube back onto its
@@ -36,27 +46,85 @@ inline void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_o
 #endif
 }
 
+// The end of an explicit stage of free element e once its lattice force f is known.
+inline void explicit_update(uint e, real4* ui, real4* vi, real4 f, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS,
+                            real dt, int symplectic) {
+  torus_grip grip = {0};  // friction of the indenters and tori (no-op without VB_FRICTION)
+  real4 a = acceleration_from(f, e, *ui, *vi, VB_LATTICE_ARGS, indenters, t_force, &grip);
+#if VB_TORI
+  const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
+  torus_constrain_all(&a, X + xyz0(*ui), indenters, t_force, h, &grip);
+#endif
+  if (symplectic) *vi += dt * a;
+  if (symplectic) torus_apply_grip(vi, grip, dt);
+  *ui += dt * xyz0(*vi);
+  if (!symplectic) *vi += dt * a;
+  if (!symplectic) torus_apply_grip(vi, grip, dt);
+  finish_stage(e, ui, vi, cell_of, sy, sz, origin, h, indenters, t_project);
+}
+
+// The corrector's end for free element e once the lattice force f at (ũ, ṽ) is known: returns v',
+// moves ui to u'.
+inline real4 correct_update(uint e, real4* ui, real4 vi, real4 up, real4 vp, real4 f, VB_LATTICE_PARAMS,
+                            VB_INDENTER_PARAMS, real dt) {
+  torus_grip grip = {0};
+  real4 a = acceleration_from(f, e, up, vp, VB_LATTICE_ARGS, indenters, t_force, &grip);
+#if VB_TORI
+  const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
+  torus_constrain_all(&a, X + xyz0(up), indenters, t_force, h, &grip);
+#endif
+  real4 vn = xyz0((vi + vp) * (real)0.5 + (real)0.5 * dt * a);
+  torus_apply_grip(&vn, grip, (real)0.5 * dt);  // the predictor's half reaches vn through ṽ
+  *ui += (real)0.5 * dt * xyz0(vi + vp);
+  finish_stage(e, ui, &vn, cell_of, sy, sz, origin, h, indenters, t_project);
+  return vn;
+}
+
+// VB_SPLIT > 1 (Heun on GPUs, small hyperelastic models; VOXBREAST_FORCE_SPLIT): each element's 26
+// connections are summed by VB_SPLIT work-items, a group of VB_SPLIT_WG holding VB_SPLIT_PER
+// elements, part p in work-items p·VB_SPLIT_PER + i (whole warps per part, so the range of
+// connections is uniform in a warp). Part 0 adds the other parts' sums from local memory in a fixed
+// order (deterministic) and finishes the element. More threads for a latency-bound pass at sizes
+// that fill a GPU only a few warps deep.
+#if VB_SPLIT > 1
+#define VB_SPLIT_WG 128
+#define VB_SPLIT_PER (VB_SPLIT_WG / VB_SPLIT)
+#define VB_STEP_ATTR __attribute__((reqd_work_group_size(VB_SPLIT_WG, 1, 1)))
+inline uint split_element(void) { return get_group_id(0) * VB_SPLIT_PER + get_local_id(0) % VB_SPLIT_PER; }
+
+// The lattice force on e summed over the parts (in part 0; every work-item of the group must call).
+inline real4 split_lattice_force(int active, uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                                 VB_LATTICE_PARAMS, VB_PENDING_PARAMS, local real4* share) {
+  const uint l = get_local_id(0), part = l / VB_SPLIT_PER;
+  real4 f = (real4)(0);
+  if (active)
+    f = lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, (int)(26 * part / VB_SPLIT),
+                              (int)(26 * (part + 1) / VB_SPLIT));
+  if (part) share[l] = f;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (!part)
+    for (int p = 1; p < VB_SPLIT; ++p) f += share[l + p * VB_SPLIT_PER];
+  return f;
+}
+#else
+#define VB_STEP_ATTR
+#endif
+
 // One explicit stage from (u, v): symplectic Euler updates v first and moves with the new v;
 // Heun's predictor (explicit Euler) moves with the old v. `symplectic` is a constant at each call.
+// (u, v) may have a volume projection pending (kernels/common.cl): the stage starts from the
+// projected state, its own included.
 inline void explicit_stage(global const real4* u, global const real4* v, global real4* u_out,
                            global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                           uint n, int symplectic) {
+                           uint n, int symplectic, VB_PENDING_PARAMS) {
   const uint e = get_global_id(0);
   if (e >= n) return;
-  real4 ui = u[e], vi = v[e];
+  real4 ui = u[e], vi = v[e], wg = (real4)(0);
+  pending_u(&ui, &wg, e, VB_PENDING_ARGS);
+  pending_v(&vi, wg, VB_PENDING_ARGS);
   if (ui.w != 0) {
-    torus_grip grip = {0};  // friction of the indenters and tori (no-op without VB_FRICTION)
-    real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force, &grip);
-#if VB_TORI
-    const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
-    torus_constrain_all(&a, X + xyz0(ui), indenters, t_force, h, &grip);
-#endif
-    if (symplectic) vi += dt * a;
-    if (symplectic) torus_apply_grip(&vi, grip, dt);
-    ui += dt * xyz0(vi);
-    if (!symplectic) vi += dt * a;
-    if (!symplectic) torus_apply_grip(&vi, grip, dt);
-    finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, indenters, t_project);
+    const real4 f = lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, 0, 26);
+    explicit_update(e, &ui, &vi, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, symplectic);
   }
   u_out[e] = ui;
   v_out[e] = vi;
@@ -65,33 +133,78 @@ inline void explicit_stage(global const real4* u, global const real4* v, global 
 kernel void euler_step(global const real4* u, global const real4* v, global real4* u_out,
                        global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
                        uint n) {
-  explicit_stage(u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1);
+  explicit_stage(u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1, VB_NO_PENDING);
 }
 
-kernel void heun_predict(global const real4* u, global const real4* v, global real4* u_pred,
-                         global real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                         uint n) {
-  explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0);
-}
-
-kernel void heun_correct(global real4* u, global real4* v, global const real4* u_pred,
-                         global const real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS,
-                         real dt, uint n) {
-  const uint e = get_global_id(0);
-  if (e >= n) return;
-  real4 ui = u[e];
-  if (ui.w == 0) return;
-  const real4 vi = v[e], up = u_pred[e], vp = v_pred[e];
-  torus_grip grip = {0};
-  real4 a = acceleration(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t_force, &grip);
-#if VB_TORI
-  const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
-  torus_constrain_all(&a, X + xyz0(up), indenters, t_force, h, &grip);
+// With VB_VOLUME_FOLD (Heun with the volume constraint, kernels/volume.cl: volume_pending) the
+// stepping kernels take the pending projections' gradients and scalars {λ, μ, …} (zero scalars
+// when none is pending): heun_predict that of (u, v); heun_correct that of (u, v) for the element's
+// own u, v and that of the predicted stage (ũ, ṽ) for every read of it.
+#if VB_VOLUME_FOLD
+#define VB_FOLD_PARAMS(name) , global const real4 *name##_g, global const real *name##_scalars
+#define VB_FOLD_PENDING(name) name##_g, name##_scalars[0], name##_scalars[1], 1
+#else
+#define VB_FOLD_PARAMS(name)
+#define VB_FOLD_PENDING(name) VB_NO_PENDING
 #endif
-  real4 vn = xyz0((vi + vp) * (real)0.5 + (real)0.5 * dt * a);
-  torus_apply_grip(&vn, grip, (real)0.5 * dt);  // the predictor's half reaches vn through ṽ
-  ui += (real)0.5 * dt * xyz0(vi + vp);
-  finish_stage(e, &ui, &vn, cell_of, sy, sz, origin, h, indenters, t_project);
+
+kernel VB_STEP_ATTR void heun_predict(global const real4* u, global const real4* v, global real4* u_pred,
+                                      global real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
+                                      uint n VB_FOLD_PARAMS(state)) {
+#if VB_SPLIT > 1
+  local real4 share[VB_SPLIT_WG];
+  const uint e = split_element();
+  const int in = e < n;
+  real4 ui = (real4)(0), vi = (real4)(0), wg = (real4)(0);
+  if (in) {
+    ui = u[e];
+    vi = v[e];
+    pending_u(&ui, &wg, e, VB_FOLD_PENDING(state));
+    pending_v(&vi, wg, VB_FOLD_PENDING(state));
+  }
+  const real4 f = split_lattice_force(in && ui.w != 0, e, ui, vi, u, v, VB_LATTICE_ARGS, VB_FOLD_PENDING(state), share);
+  if (!in || get_local_id(0) >= VB_SPLIT_PER) return;
+  if (ui.w != 0) explicit_update(e, &ui, &vi, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, 0);
+  u_pred[e] = ui;
+  v_pred[e] = vi;
+#else
+  explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0, VB_FOLD_PENDING(state));
+#endif
+}
+
+kernel VB_STEP_ATTR void heun_correct(global real4* u, global real4* v, global const real4* u_pred,
+                                      global const real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS,
+                                      real dt, uint n VB_FOLD_PARAMS(state) VB_FOLD_PARAMS(pred)) {
+#if VB_SPLIT > 1
+  local real4 share[VB_SPLIT_WG];
+  const uint e = split_element();
+  const int in = e < n;
+#else
+  const uint e = get_global_id(0);
+  const int in = e < n;
+  if (!in) return;
+#endif
+  real4 ui = (real4)(0), vi = (real4)(0), up = (real4)(0), vp = (real4)(0), wg = (real4)(0), wgp = (real4)(0);
+  if (in) {
+    ui = u[e];
+    vi = v[e];
+    up = u_pred[e];
+    vp = v_pred[e];
+    pending_u(&ui, &wg, e, VB_FOLD_PENDING(state));
+    pending_v(&vi, wg, VB_FOLD_PENDING(state));
+    pending_u(&up, &wgp, e, VB_FOLD_PENDING(pred));
+    pending_v(&vp, wgp, VB_FOLD_PENDING(pred));
+  }
+#if VB_SPLIT > 1
+  const real4 f = split_lattice_force(in && ui.w != 0, e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS,
+                                      VB_FOLD_PENDING(pred), share);
+  if (!in || get_local_id(0) >= VB_SPLIT_PER) return;
+  if (ui.w == 0) return;
+#else
+  if (ui.w == 0) return;
+  const real4 f = lattice_force_pending(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, VB_FOLD_PENDING(pred), 0, 26);
+#endif
+  const real4 vn = correct_update(e, &ui, vi, up, vp, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt);
   u[e] = ui;
   v[e] = vn;
 }

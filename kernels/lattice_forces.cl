@@ -32,8 +32,13 @@ inline real spring_end(int law, global const real* mat, real k, real len, real r
 // c_hg·k(|r| − |F·r₀|), whose rest length is the length its own affine fit predicts, so affine
 // fields feel no hourglass force (r₀ the connection at rest: h·d, or h·d + Δu0 with rest offsets,
 // F the element's deformation from rest).
-// u: displacement (m) with w = inverse mass (1/kg, 0 = held); v: velocity (m/s).
-real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v, VB_LATTICE_PARAMS) {
+// u: displacement (m) with w = inverse mass (1/kg, 0 = held); v: velocity (m/s). With a pending
+// volume projection (VB_PENDING_PARAMS, kernels/common.cl) the neighbours' u, v are read as the
+// projection leaves them; ui, vi are the caller's (already projected). Only connections d_lo ≤ d <
+// d_hi are summed (kernels/integrate.cl, VB_SPLIT: parts of an element's connections on several
+// work-items); 0, 26 for all.
+real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                            VB_LATTICE_PARAMS, VB_PENDING_PARAMS, int d_lo, int d_hi) {
   const int cell = (int)cell_of[e];
   const real Ei = E[e];
   real4 f = (real4)(0);
@@ -50,12 +55,14 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
 #endif
 #pragma unroll
   for (int d = 0; d < 26; ++d) {
+    if (d < d_lo || d >= d_hi) continue;  // d is a constant once unrolled; the range is uniform
     // Branch-free: a missing neighbour reads the element itself and is masked out, so CPU
     // compilers can vectorise across work-items.
     const int jn = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
     const real present = jn >= 0 ? (real)1 : (real)0;
     const int j = jn >= 0 ? jn : (int)e;
-    const real4 uj = u[j];
+    real4 uj = u[j], wgj = (real4)(0);
+    pending_u(&uj, &wgj, (uint)j, VB_PENDING_ARGS);
     const real4 hd = (real4)(h * VB_DIR[d][0], h * VB_DIR[d][1], h * VB_DIR[d][2], 0);
     const real4 r = (real4)(hd.x + (uj.x - ui.x), hd.y + (uj.y - ui.y), hd.z + (uj.z - ui.z), 0);
     const real len_sq = dot3(r, r);
@@ -109,7 +116,9 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
     real magnitude = k * (len - rest);
 #endif
 #if VB_DASHPOT
-    magnitude += 2 * dashpot_ratio * sqrt(kE * q) * dot3(v[j] - vi, n);
+    real4 vj = v[j];
+    pending_v(&vj, wgj, VB_PENDING_ARGS);
+    magnitude += 2 * dashpot_ratio * sqrt(kE * q) * dot3(vj - vi, n);
 #endif
     f += magnitude * n;
   }
@@ -117,6 +126,11 @@ real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global co
   if (VB_LAW_HYPER(law_i)) f += mat3_apply(mat3_load(Qs, e), own_offsets);
 #endif
   return f;
+}
+
+inline real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                           VB_LATTICE_PARAMS) {
+  return lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_NO_PENDING, 0, 26);
 }
 
 // Net force on a free element from the lattice and gravity (N), before contact constraints.

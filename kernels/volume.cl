@@ -18,7 +18,16 @@
 //     and the last one to finish (a count in global memory) sums them all (same order as
 //     volume_finish), writes the scalars and applies x += λ·w·g, v −= μ·w·g to every free surface
 //     element. Work-groups of VB_VOLUME_WG: wide on GPUs, where one group does the applying.
+//   volume_pending (VB_VOLUME_FOLD, Heun only): volume_partials whose last work-group to finish
+//     also computes the scalars (the same sums in the same order as volume_apply's), and nothing
+//     is applied: the kernels that read the state next apply x + λ·w·g, v − μ·w·g on the fly
+//     (VB_PENDING_PARAMS, kernels/common.cl), so a projection is one short launch.
 #define VB_VOLUME_SLOTS 5
+#if VB_VOLUME_PAIRS
+#define VB_INCIDENT uint2
+#else
+#define VB_INCIDENT uint
+#endif
 
 inline real4 element_position(uint e, global const real4* u, global const uint* cell_of, int sy,
                               int sz, real4 origin, real h, real4 centre) {
@@ -42,7 +51,7 @@ inline void sum_over_group(local real* s, uint wg, const real* value, uint l) {
 inline void volume_item_values(uint i, global const real4* u, global const real4* v, VB_LATTICE_PARAMS,
                                global const uint* triangles, uint n_triangles,
                                global const uint* surface_elements, global const uint* incident_start,
-                               global const uint* incident, uint n_surface, real4 centre,
+                               global const VB_INCIDENT* incident, uint n_surface, real4 centre,
                                global real4* grad, int with_force, real value[VB_VOLUME_SLOTS]) {
   for (int k = 0; k < VB_VOLUME_SLOTS; ++k) value[k] = 0;
   if (i < n_triangles) {
@@ -53,15 +62,22 @@ inline void volume_item_values(uint i, global const real4* u, global const real4
   }
   if (i < n_surface) {
     const uint e = surface_elements[i];
-    // ∂(x0·(x1 × x2))/∂x0 = x1 × x2, cyclically; incident[] holds 3·triangle + corner. Each
-    // term is a chain of four dependent loads (corner, triangle, cell, u): unrolled, the chains of
-    // several triangles overlap on a GPU (the sum keeps its order).
+    // ∂(x0·(x1 × x2))/∂x0 = x1 × x2, cyclically. With VB_VOLUME_PAIRS incident[] holds, per
+    // incident triangle, its two other corners' elements in cyclic order: each term is a chain of
+    // two dependent loads (pair, then cell and u together). Without, it holds 3·triangle + corner:
+    // four (corner, triangle, cell, u). Unrolled, the chains of several triangles overlap on a GPU
+    // (the sum keeps its order; both forms give the same value).
     real4 g = 0;
 #pragma unroll 4
     for (uint k = incident_start[i]; k < incident_start[i + 1]; ++k) {
+#if VB_VOLUME_PAIRS
+      const uint2 bc = incident[k];
+#else
       const uint t = incident[k] / 3, corner = incident[k] - 3 * t;
-      const real4 b = element_position(triangles[3 * t + (corner + 1) % 3], u, cell_of, sy, sz, origin, h, centre);
-      const real4 c = element_position(triangles[3 * t + (corner + 2) % 3], u, cell_of, sy, sz, origin, h, centre);
+      const uint2 bc = (uint2)(triangles[3 * t + (corner + 1) % 3], triangles[3 * t + (corner + 2) % 3]);
+#endif
+      const real4 b = element_position(bc.x, u, cell_of, sy, sz, origin, h, centre);
+      const real4 c = element_position(bc.y, u, cell_of, sy, sz, origin, h, centre);
       g += cross(b, c);
     }
     g = xyz0(g) / (real)6;
@@ -79,7 +95,7 @@ inline void volume_item_values(uint i, global const real4* u, global const real4
 
 #define VB_VOLUME_MESH_PARAMS                                                                   \
   global const uint *triangles, uint n_triangles, global const uint *surface_elements,          \
-      global const uint *incident_start, global const uint *incident, uint n_surface, real4 centre
+      global const uint *incident_start, global const VB_INCIDENT *incident, uint n_surface, real4 centre
 #define VB_VOLUME_MESH_ARGS triangles, n_triangles, surface_elements, incident_start, incident, n_surface, centre
 
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
@@ -144,6 +160,28 @@ void volume_apply(global real4* u, global real4* v, global const uint* surface_e
   volume_apply_one(e, u, v, grad[e], out);
 }
 
+// Each work-group's partial sums (and every surface element's g), then the group counts itself;
+// true (in every work-item) in the last group to finish, which may then read all partials and
+// gradients through volatile pointers (past the non-coherent L1 on NVIDIA).
+inline int partials_counted(global const real4* u, global const real4* v, VB_LATTICE_PARAMS, VB_VOLUME_MESH_PARAMS,
+                            global real4* grad, global real* partial, volatile global uint* groups_done,
+                            local real* s, local int* last, uint wg) {
+  const uint l = get_local_id(0);
+  real value[VB_VOLUME_SLOTS];
+  volume_item_values(get_global_id(0), u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, 0, value);
+  sum_over_group(s, wg, value, l);
+  if (l == 0)
+    for (int k = 0; k < VB_VOLUME_SLOTS; ++k) partial[get_group_id(0) * VB_VOLUME_SLOTS + k] = s[k * wg];
+  // every work-item's g and the group's partials are globally visible before the group is counted
+  mem_fence(CLK_GLOBAL_MEM_FENCE);
+  barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
+  if (l == 0) *last = atomic_inc(groups_done) == get_num_groups(0) - 1;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (!*last) return 0;
+  mem_fence(CLK_GLOBAL_MEM_FENCE);
+  return 1;
+}
+
 kernel __attribute__((reqd_work_group_size(VB_VOLUME_WG, 1, 1)))
 void volume_project(global real4* u, global real4* v, VB_LATTICE_PARAMS, VB_VOLUME_MESH_PARAMS,
                     global real4* grad, global real* partial, real rest_volume, global real* scalars,
@@ -151,19 +189,10 @@ void volume_project(global real4* u, global real4* v, VB_LATTICE_PARAMS, VB_VOLU
   local real s[VB_VOLUME_SLOTS * VB_VOLUME_WG];
   local int last;
   const uint l = get_local_id(0);
-  real value[VB_VOLUME_SLOTS];
-  volume_item_values(get_global_id(0), u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, 0, value);
-  sum_over_group(s, VB_VOLUME_WG, value, l);
-  if (l == 0)
-    for (int k = 0; k < VB_VOLUME_SLOTS; ++k) partial[get_group_id(0) * VB_VOLUME_SLOTS + k] = s[k * VB_VOLUME_WG];
-  // every work-item's g and the group's partials are globally visible before the group is counted
-  mem_fence(CLK_GLOBAL_MEM_FENCE);
-  barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
-  if (l == 0) last = atomic_inc(groups_done) == get_num_groups(0) - 1;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  if (!last) return;
+  if (!partials_counted(u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, partial, groups_done, s, &last,
+                        VB_VOLUME_WG))
+    return;
   // The last group: the other groups' partials and gradients are read past any cache (volatile).
-  mem_fence(CLK_GLOBAL_MEM_FENCE);
   real out[4];
   volume_scalars(partial, get_num_groups(0), rest_volume, s, VB_VOLUME_WG, l, out);
   volatile global const real4* g_all = grad;
@@ -184,3 +213,26 @@ void volume_project(global real4* u, global real4* v, VB_LATTICE_PARAMS, VB_VOLU
     *groups_done = 0;  // ready for the next launch
   }
 }
+
+#if VB_VOLUME_FOLD
+// The projection of (u, v) left pending (see the top of this file): the gradient into `grad`, and
+// λ, μ, V, p into `scalars` by the last work-group, summed as volume_apply sums them (work-groups
+// of VB_CHECK_WG, so the same partials in the same order: the same values as the two-launch form).
+kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
+void volume_pending(global const real4* u, global const real4* v, VB_LATTICE_PARAMS, VB_VOLUME_MESH_PARAMS,
+                    global real4* grad, global real* partial, real rest_volume, global real* scalars,
+                    volatile global uint* groups_done) {
+  local real s[VB_VOLUME_SLOTS * VB_CHECK_WG];
+  local int last;
+  const uint l = get_local_id(0);
+  if (!partials_counted(u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, partial, groups_done, s, &last,
+                        VB_CHECK_WG))
+    return;
+  real out[4];
+  volume_scalars(partial, get_num_groups(0), rest_volume, s, VB_CHECK_WG, l, out);
+  if (l == 0) {
+    for (int k = 0; k < 4; ++k) scalars[k] = out[k];
+    *groups_done = 0;  // ready for the next launch
+  }
+}
+#endif

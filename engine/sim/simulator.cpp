@@ -18,6 +18,9 @@ constexpr int kCheckWorkGroup = 128;
 // volume_project's work-groups on GPUs (kernels/volume.cl): its last group applies the projection
 // to the whole surface, so wide groups keep that tail short
 constexpr std::size_t kVolumeGpuWorkGroup = 512;
+// VB_SPLIT (kernels/integrate.cl): work-group size of the split Heun kernels, and the model size
+// up to which GPUs split (the perf branch gained at 36k elements and lost nothing to ~100k)
+constexpr std::size_t kSplitWorkGroup = 128, kSplitMaxElements = 262144;
 constexpr int kCheckBaseSlots = 5, kCheckSlotsPerIndenter = 4;  // kernels/checks.cl
 constexpr int kCheckSlotsPerTorus = 8;                             // VB_TORUS_SLOTS
 constexpr int kIndenterStride = 20;                                // VB_IND_STRIDE
@@ -72,7 +75,7 @@ std::size_t estimated_volume_device_bytes(std::size_t elements, std::size_t surf
   const std::size_t real = precision == Precision::Double ? 8 : 4;
   const std::size_t groups = (std::max(surface_elements, triangles) + kCheckWorkGroup - 1) / kCheckWorkGroup;
   return triangles * 3 * 4                       // triangle corners (element ids)
-         + surface_elements * 4 + (surface_elements + 1) * 4 + triangles * 3 * 4  // CSR of incident corners
+         + surface_elements * 4 + (surface_elements + 1) * 4 + triangles * 3 * 8  // CSR of incident corners (pairs)
          + elements * 4 * real                   // gradient per element
          + (groups * kVolumeSlots + kVolumeScalars) * real;
 }
@@ -211,13 +214,40 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     // (volume_project). On an H200 the one-launch form's last work-group, applying the projection
     // alone, took 21.8 µs against 7.9 + 10.8 µs for the two launches (docs/PERF_NOTES.md); on PoCL
     // the two cost the same. VOXBREAST_VOLUME_LAUNCHES=1|2 overrides, to compare them on a device.
+    // 0 (Heun only): no apply launch at all, the kernels that read the state next apply the
+    // pending projection (volume_pending; kernels/common.cl, VB_PENDING_PARAMS).
     volume_launches_ = cl.info.is_gpu ? 2 : 1;
-    if (const char* env = std::getenv("VOXBREAST_VOLUME_LAUNCHES")) volume_launches_ = std::atoi(env) == 2 ? 2 : 1;
+    if (const char* env = std::getenv("VOXBREAST_VOLUME_LAUNCHES")) {
+      const int k = std::atoi(env);
+      if (k == 1 || k == 2) volume_launches_ = k;
+      if (k == 0 && scene.solver.integrator == Integrator::Heun) volume_launches_ = 0;
+    }
     const bool wide = cl.info.is_gpu &&
                       cl.info.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>() >= kVolumeGpuWorkGroup &&
                       kVolumeSlots * kVolumeGpuWorkGroup * real_size_ + 64 <= local_bytes;
     volume_wg_ = wide ? kVolumeGpuWorkGroup : std::size_t(kCheckWorkGroup);
     options += " -DVB_VOLUME_WG=" + std::to_string(volume_wg_);
+    // The volume gradient's incident triangles as element pairs (two dependent loads per term
+    // instead of four, kernels/volume.cl); VOXBREAST_VOLUME_PAIRS=0 keeps corner indices, to compare.
+    const char* pairs = std::getenv("VOXBREAST_VOLUME_PAIRS");
+    volume_pairs_ = !(pairs && std::atoi(pairs) == 0);
+    options += " -DVB_VOLUME_PAIRS=" + std::to_string(volume_pairs_);
+  }
+  options += " -DVB_VOLUME_FOLD=" + std::to_string(volume_ && volume_launches_ == 0);
+  // Heun's force passes on GPUs with each element's connections over 2 work-items for small
+  // hyperelastic models (kernels/integrate.cl, VB_SPLIT): ~1,100 warps at 36k elements leave a
+  // latency-bound pass short of threads. VOXBREAST_FORCE_SPLIT=1|2|4 overrides, on any device.
+  const bool heun_steps = scene.solver.integrator == Integrator::Heun;
+  force_split_ = heun_steps && cl.info.is_gpu && el.hyperelastic && n_ <= kSplitMaxElements ? 2 : 1;
+  if (const char* env = std::getenv("VOXBREAST_FORCE_SPLIT")) {
+    const int k = std::atoi(env);
+    if (heun_steps && (k == 1 || k == 2 || k == 4)) force_split_ = k;
+  }
+  options += " -DVB_SPLIT=" + std::to_string(force_split_);
+  {
+    const std::size_t per = kSplitWorkGroup / std::size_t(force_split_);
+    step_global_ = force_split_ > 1 ? cl::NDRange((n_ + per - 1) / per * kSplitWorkGroup) : global_;
+    step_local_ = force_split_ > 1 ? cl::NDRange(kSplitWorkGroup) : local_;
   }
   const bool friction = std::any_of(scene.tori.begin(), scene.tori.end(), [](const TorusSpec& t) { return t.friction > 0; }) ||
                         std::any_of(scene.indenters.begin(), scene.indenters.end(),
@@ -342,6 +372,15 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   incident.resize(start.back());
   std::vector<cl_uint> fill(start.begin(), start.end() - 1);
   for (std::size_t k = 0; k < triangles.size(); ++k) incident[fill[surface_index[triangles[k]]]++] = cl_uint(k);
+  if (volume_pairs_) {  // per incident corner the triangle's other two corners' elements, in cyclic order
+    std::vector<cl_uint> pairs(2 * incident.size());
+    for (std::size_t k = 0; k < incident.size(); ++k) {
+      const std::size_t t = incident[k] / 3, corner = incident[k] % 3;
+      pairs[2 * k] = triangles[3 * t + (corner + 1) % 3];
+      pairs[2 * k + 1] = triangles[3 * t + (corner + 2) % 3];
+    }
+    incident = std::move(pairs);
+  }
 
   volume_triangles_ = mesh.triangles.size();
   volume_surface_ = surface.size();
@@ -397,6 +436,20 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   vol_project_.setArg(kProjectGrad + 1, vol_partial_);
   vol_project_.setArg(kProjectRestVolume + 1, vol_scalars_);
   vol_project_.setArg(kProjectRestVolume + 2, vol_done_);
+  if (volume_launches_ == 0) {
+    // the predicted stage's projection has its own gradient and scalars: the state's stays
+    // pending for heun_correct's own u, v while the stage's is computed
+    vol_grad_pred_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, zeros.size(), zeros.data());
+    vol_scalars_pred_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, scalar_zeros.size(),
+                                   scalar_zeros.data());
+    vol_no_scalars_ = cl::Buffer(cl_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, scalar_zeros.size(),
+                                 scalar_zeros.data());
+    device_bytes_ += 4 * real_size_ * n_;
+    vol_pending_ = mesh_kernel("volume_pending");
+    vol_pending_.setArg(kProjectGrad + 1, vol_partial_);
+    vol_pending_.setArg(kProjectRestVolume + 2, vol_done_);
+    set_fold_args(false, false);
+  }
   set_rest_volume_args();
   check_.setArg(kCheckVolume, vol_grad_);
   check_.setArg(kCheckVolume + 1, vol_scalars_);
@@ -407,6 +460,39 @@ void Simulator::set_rest_volume_args() {
   set_real(vol_finish_, 2, v0);
   set_real(vol_apply_, kApplyRestVolume, v0);
   set_real(vol_project_, kProjectRestVolume, v0);
+  if (volume_launches_ == 0) set_real(vol_pending_, kProjectRestVolume, v0);
+}
+
+void Simulator::set_fold_args(bool state_pending, bool pred_pending) {
+  // kernels/integrate.cl (VB_FOLD_PARAMS): after dt, n the state's gradient and scalars, then
+  // (heun_correct) the predicted stage's; zero scalars where nothing is pending
+  const cl::Buffer& state = state_pending ? vol_scalars_ : vol_no_scalars_;
+  const cl::Buffer& pred = pred_pending ? vol_scalars_pred_ : vol_no_scalars_;
+  const int a = kStepIndenter + kIndenterArgs + 2;
+  for (cl::Kernel* k : {&predict_, &correct_}) {
+    k->setArg(a, vol_grad_);
+    k->setArg(a + 1, state);
+  }
+  correct_.setArg(a + 2, vol_grad_pred_);
+  correct_.setArg(a + 3, pred);
+}
+
+void Simulator::enqueue_pending_projection(const cl::Buffer& u, const cl::Buffer& v, bool predicted) {
+  vol_pending_.setArg(0, u);
+  vol_pending_.setArg(1, v);
+  vol_pending_.setArg(kProjectGrad, predicted ? vol_grad_pred_ : vol_grad_);
+  vol_pending_.setArg(kProjectRestVolume + 1, predicted ? vol_scalars_pred_ : vol_scalars_);
+  launch(vol_pending_, cl::NDRange(volume_groups_ * kCheckWorkGroup), cl::NDRange(kCheckWorkGroup));
+}
+
+void Simulator::apply_pending_projection() const {
+  if (!pending_) return;
+  // volume_apply sums the partials the last volume_pending left (the same λ, μ) and applies them
+  pending_ = false;
+  vol_apply_.setArg(0, u_);
+  vol_apply_.setArg(1, v_);
+  const std::size_t wg = kCheckWorkGroup, global = (volume_surface_ + wg - 1) / wg * wg;
+  launch(vol_apply_, cl::NDRange(global), cl::NDRange(wg));
 }
 
 void Simulator::enqueue_volume_sums(bool with_force) { enqueue_volume_sums(with_force, u_, v_); }
@@ -440,6 +526,7 @@ void Simulator::enqueue_volume_correction(const cl::Buffer& u, const cl::Buffer&
 
 double Simulator::enclosed_volume_m3() {
   require(volume_, "the enclosed volume is computed on the device only with [volume] preserve = true");
+  apply_pending_projection();
   enqueue_volume_sums(false);
   return read_enclosed_volume_m3();
 }
@@ -458,6 +545,7 @@ double Simulator::read_enclosed_volume_m3() const {
 
 std::vector<double> Simulator::volume_gradient_m2() {
   require(volume_, "the volume gradient is computed on the device only with [volume] preserve = true");
+  apply_pending_projection();
   enqueue_volume_sums(false);
   std::vector<double> g;
   if (precision_ == Precision::Double) read_xyz<double>(vol_grad_, g); else read_xyz<float>(vol_grad_, g);
@@ -670,9 +758,13 @@ std::map<std::string, KernelProfile> Simulator::kernel_profile() const {
 
 void Simulator::enqueue(cl::Kernel& k) const { launch(k, global_, local_); }
 
-void Simulator::enqueue_stress(const cl::Buffer& u) {
+void Simulator::enqueue_stress(const cl::Buffer& u, const cl::Buffer* pending_grad, const cl::Buffer* pending_scalars) {
   if (!hyper_) return;
   stress_.setArg(0, u);
+  if (volume_launches_ == 0) {  // element_stress's pending projection (VB_VOLUME_FOLD)
+    stress_.setArg(12, pending_grad ? *pending_grad : vol_grad_);
+    stress_.setArg(13, pending_scalars ? *pending_scalars : vol_no_scalars_);
+  }
   enqueue(stress_);
 }
 
@@ -696,13 +788,27 @@ void Simulator::advance(std::int64_t steps) {
         set_indenter_args(correct_, kStepIndenter, t1, t1);
       }
       const bool project = volume_ && (steps_ + 1) % scene_.volume.every == 0;
+      if (volume_launches_ == 0) {
+        // Projections left pending (kernels/volume.cl, volume_pending): the readers of each
+        // projected state apply it, and only the state's own gradient and scalars stay pending
+        // after the step.
+        set_fold_args(pending_, project);
+        enqueue_stress(u_, &vol_grad_, pending_ ? &vol_scalars_ : &vol_no_scalars_);
+        launch(predict_, step_global_, step_local_);
+        if (project) enqueue_pending_projection(u_tmp_, v_tmp_, true);
+        enqueue_stress(u_tmp_, &vol_grad_pred_, project ? &vol_scalars_pred_ : &vol_no_scalars_);
+        launch(correct_, step_global_, step_local_);
+        if (project) enqueue_pending_projection(u_, v_, false);
+        pending_ = project;
+        continue;
+      }
       enqueue_stress(u_);
-      enqueue(predict_);
+      launch(predict_, step_global_, step_local_);
       // The predicted stage is projected too: its velocity along g would otherwise reach the
       // corrector's dashpots and leave a steady slip at the constrained equilibrium.
       if (project) enqueue_volume_correction(u_tmp_, v_tmp_);
       enqueue_stress(u_tmp_);
-      enqueue(correct_);
+      launch(correct_, step_global_, step_local_);
     } else {
       cl::Kernel& k = relax_ ? relax_kernel_ : euler_;
       k.setArg(0, u_); k.setArg(1, v_); k.setArg(2, u_tmp_); k.setArg(3, v_tmp_);
@@ -718,6 +824,7 @@ void Simulator::advance(std::int64_t steps) {
 }
 
 StateCheck Simulator::check() {
+  apply_pending_projection();
   check_.setArg(0, u_);
   check_.setArg(1, v_);
   set_indenter_args(check_, kCheckIndenter, time_s(), time_s());
@@ -797,6 +904,7 @@ void Simulator::set_gravity(const Vec3& g) {
   if (volume_) {
     set_world_vector(vol_partials_, 2 + 7, g);
     set_world_vector(vol_project_, 2 + 7, g);
+    if (volume_launches_ == 0) set_world_vector(vol_pending_, 2 + 7, g);
   }
 }
 
@@ -828,6 +936,7 @@ std::vector<double> Simulator::to_lattice_frame(const std::vector<double>& world
 }
 
 void Simulator::download(std::vector<double>& u, std::vector<double>& v) const {
+  apply_pending_projection();
   if (precision_ == Precision::Double) {
     read_xyz<double>(u_, u);
     read_xyz<double>(v_, v);
@@ -839,6 +948,7 @@ void Simulator::download(std::vector<double>& u, std::vector<double>& v) const {
 
 void Simulator::upload(const std::vector<double>& u, const std::vector<double>& v) {
   require(u.size() == 3 * n_ && v.size() == 3 * n_, "state size does not match the model");
+  pending_ = false;  // the new state replaces the one the projection was for
   if (precision_ == Precision::Double) {
     write_xyz<double>(u_, u, &inverse_mass_);
     write_xyz<double>(v_, v, nullptr);
@@ -856,6 +966,7 @@ std::vector<double> Simulator::lattice_forces() {
   set_lattice_args(k, 2);
   k.setArg(2 + kLatticeArgs, f);
   k.setArg(3 + kLatticeArgs, cl_uint(n_));
+  apply_pending_projection();
   enqueue_stress(u_);
   enqueue(k);
   std::vector<double> out;

@@ -135,8 +135,13 @@ class Simulator {
   /// by kernel name; waits for the device
   std::map<std::string, KernelProfile> kernel_profile() const;
   /// kernel launches per projection of the volume constraint: 1 (volume_project) or 2
-  /// (volume_partials, volume_apply; VOXBREAST_VOLUME_LAUNCHES=2)
+  /// (volume_partials, volume_apply; VOXBREAST_VOLUME_LAUNCHES=2), or 0 (Heun only,
+  /// VOXBREAST_VOLUME_LAUNCHES=0): volume_pending computes the projection and the kernels that read
+  /// the state next apply it, with no apply launch (kernels/volume.cl)
   int volume_launches() const { return volume_launches_; }
+  /// work-items per element in Heun's force passes (kernels/integrate.cl, VB_SPLIT): 2 on GPUs for
+  /// hyperelastic models up to 262,144 elements, else 1; VOXBREAST_FORCE_SPLIT=1|2|4 overrides
+  int force_split() const { return force_split_; }
 
  private:
   void set_indenter_args(cl::Kernel& k, int first_arg, double t_force, double t_project);
@@ -158,7 +163,10 @@ class Simulator {
   void enqueue(cl::Kernel& k) const;
   void enqueue_check() const;
   void adapt_relaxation_damping(const std::vector<double>& partial);
-  void enqueue_stress(const cl::Buffer& u);
+  /// element stress of u; with VOXBREAST_VOLUME_LAUNCHES=0, with u's pending projection (gradient,
+  /// scalars; none when null)
+  void enqueue_stress(const cl::Buffer& u, const cl::Buffer* pending_grad = nullptr,
+                      const cl::Buffer* pending_scalars = nullptr);
   void make_hyperelastic_buffers(const ElementArrays& el);
   /// The rigid-obstacle table the kernels read (lattice frame): indenter rows (a placeholder row if
   /// none), then torus rows and their inflation knots (kernels/device_contact.cl).
@@ -219,15 +227,29 @@ class Simulator {
   double read_enclosed_volume_m3() const;
   /// the rest volume (lattice frame) into the kernels that compute λ
   void set_rest_volume_args();
+  // VOXBREAST_VOLUME_LAUNCHES=0 (volume_launches_ == 0): projections left pending
+  /// the stepping kernels' pending projections: of (u, v) and of the predicted stage
+  void set_fold_args(bool state_pending, bool pred_pending);
+  /// volume_pending on (u, v): the gradient and scalars of the state's or the predicted stage's
+  void enqueue_pending_projection(const cl::Buffer& u, const cl::Buffer& v, bool predicted);
+  /// applies the state's pending projection (volume_apply) before anything else reads u, v
+  void apply_pending_projection() const;
+  bool volume_pairs_ = true;  ///< incident triangles as element pairs (VB_VOLUME_PAIRS)
+  mutable bool pending_ = false;
+  int force_split_ = 1;
+  cl::NDRange step_global_, step_local_;  ///< Heun's stepping kernels (VB_SPLIT)  ///< (u_, v_) has a projection pending (vol_grad_, vol_scalars_)
+  cl::Buffer vol_grad_pred_, vol_scalars_pred_, vol_no_scalars_;
+  cl::Kernel vol_pending_;
   bool volume_ = false;
   SurfaceMesh surface_;
   double rest_volume_m3_ = 0, frame_sign_ = 1;  ///< det(rotation): lattice-frame V = sign·V_world
   std::size_t volume_triangles_ = 0, volume_surface_ = 0, volume_groups_ = 0;
   std::size_t volume_wg_ = 0;   ///< work-group size of volume_project (VB_VOLUME_WG)
-  int volume_launches_ = 1;     ///< per projection: 1 volume_project, 2 volume_partials + volume_apply
+  int volume_launches_ = 1;     ///< per projection: 1 volume_project, 2 volume_partials + volume_apply, 0 folded
   cl::Buffer vol_triangles_, vol_surface_, vol_incident_start_, vol_incident_, vol_grad_, vol_partial_,
       vol_scalars_, vol_done_;
-  cl::Kernel vol_partials_, vol_finish_, vol_apply_, vol_project_;
+  cl::Kernel vol_partials_, vol_finish_, vol_project_;
+  mutable cl::Kernel vol_apply_;
 };
 
 }  // namespace vb

@@ -2,6 +2,7 @@
 // (rigid motion, total force and torque), homogeneous states against closed forms, and
 // hourglass control.
 #include <array>
+#include <cstdlib>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -220,6 +221,49 @@ TEST(HyperelasticKernels, CheckerboardDecaysWithHourglassControlAndPersistsWitho
   };
   EXPECT_LT(amplitude_after(0.1), 0.1) << "with hourglass control the checkerboard must decay";
   EXPECT_GT(amplitude_after(0.0), 0.5) << "without it the checkerboard is a zero-energy mode";
+}
+
+/// u then v after 100 Heun steps of a sagging two-term Ogden block (double, dashpots) from a smooth
+/// deformation, with `split` work-items per element in the force passes (VOXBREAST_FORCE_SPLIT).
+std::vector<double> split_steps(int split) {
+  Scene s = hyper_block(7, ogden_two_term());
+  s.solver.integrator = Integrator::Heun;
+  s.solver.dashpot_ratio = 0.1;
+  s.solver.dt_s.reset();
+  s.gravity.active = true;
+  s.gravity.acceleration_m_s2 = Vec3(0, 0, -9.81);
+  s.anchors.push_back(test::halfspace_anchor("base", Vec3(0, 0, 0.001), Vec3(0, 0, -1)));
+  const test::Model m = test::make_model(s);
+  const auto u0 = field(m.lattice, [](const Vec3& X) {
+    return Vec3(0.0002 * std::sin(300 * X.z()), 0.0001 * std::cos(400 * X.x()), -0.0002 * std::sin(250 * X.y()));
+  });
+  setenv("VOXBREAST_FORCE_SPLIT", std::to_string(split).c_str(), 1);
+  Simulator sim(s, m.lattice, m.elements, test::cl_context());
+  unsetenv("VOXBREAST_FORCE_SPLIT");
+  EXPECT_EQ(sim.force_split(), split);
+  sim.upload(u0, std::vector<double>(u0.size(), 0.0));
+  sim.advance(100);
+  std::vector<double> u, v;
+  sim.download(u, v);
+  u.insert(u.end(), v.begin(), v.end());
+  return u;
+}
+
+// Each element's connections summed by 2 or 4 work-items that meet in local memory (343 elements:
+// the last work-group is partly empty): the same trajectory as one work-item per element up to the
+// order of the sums. A part left out, counted twice or read before it is written would not be.
+TEST(HyperelasticKernels, SplitForcePassesMatchOneWorkItemPerElement) {
+  const std::vector<double> one = split_steps(1);
+  double largest = 0;
+  for (double x : one) largest = std::max(largest, std::abs(x));
+  ASSERT_GT(largest, 0);
+  for (const int split : {2, 4}) {
+    const std::vector<double> many = split_steps(split);
+    ASSERT_EQ(many.size(), one.size());
+    double diff = 0;
+    for (std::size_t i = 0; i < one.size(); ++i) diff = std::max(diff, std::abs(many[i] - one[i]));
+    EXPECT_LE(diff, 1e-12 * largest) << split << " work-items per element";
+  }
 }
 
 }  // namespace
