@@ -8,9 +8,14 @@
 //     (a(u, v) is recovered from ṽ, so no force buffer is stored).
 
 // `grip` collects the indenters' friction (device_contact.cl), turned into m/s² like the torus's.
+// With VB_TRI_CONTACT the triangle-contact forces (triangle_contact.cl, computed for the same u
+// just before this kernel) are added; VB_TRI_PARAMS is empty otherwise.
 inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                          VB_LATTICE_PARAMS, global const real* indenters, real t, torus_grip* grip) {
+                          VB_LATTICE_PARAMS, global const real* indenters, real t, torus_grip* grip VB_TRI_PARAMS) {
   real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
+#if VB_TRI_CONTACT
+  f += triangle_contact_all(e, indenters, corner_force, tri_start, tri_corner, n_tri);  // computed for this u
+#endif
 #if VB_GLOBAL_DAMPING
   f -= damping * xyz0(vi) / ui.w;
 #endif
@@ -40,13 +45,13 @@ inline void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_o
 // Heun's predictor (explicit Euler) moves with the old v. `symplectic` is a constant at each call.
 inline void explicit_stage(global const real4* u, global const real4* v, global real4* u_out,
                            global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                           uint n, int symplectic) {
+                           uint n, int symplectic VB_TRI_PARAMS) {
   const uint e = get_global_id(0);
   if (e >= n) return;
   real4 ui = u[e], vi = v[e];
   if (ui.w != 0) {
     torus_grip grip = {0};  // friction of the indenters and tori (no-op without VB_FRICTION)
-    real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force, &grip);
+    real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force, &grip VB_TRI_ARGS);
 #if VB_TORI
     const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
     torus_constrain_all(&a, X + xyz0(ui), indenters, t_force, h, &grip);
@@ -64,26 +69,26 @@ inline void explicit_stage(global const real4* u, global const real4* v, global 
 
 kernel void euler_step(global const real4* u, global const real4* v, global real4* u_out,
                        global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                       uint n) {
-  explicit_stage(u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1);
+                       uint n VB_TRI_PARAMS) {
+  explicit_stage(u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1 VB_TRI_ARGS);
 }
 
 kernel void heun_predict(global const real4* u, global const real4* v, global real4* u_pred,
                          global real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                         uint n) {
-  explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0);
+                         uint n VB_TRI_PARAMS) {
+  explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0 VB_TRI_ARGS);
 }
 
 kernel void heun_correct(global real4* u, global real4* v, global const real4* u_pred,
                          global const real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS,
-                         real dt, uint n) {
+                         real dt, uint n VB_TRI_PARAMS) {
   const uint e = get_global_id(0);
   if (e >= n) return;
   real4 ui = u[e];
   if (ui.w == 0) return;
   const real4 vi = v[e], up = u_pred[e], vp = v_pred[e];
   torus_grip grip = {0};
-  real4 a = acceleration(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t_force, &grip);
+  real4 a = acceleration(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t_force, &grip VB_TRI_ARGS);
 #if VB_TORI
   const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
   torus_constrain_all(&a, X + xyz0(up), indenters, t_force, h, &grip);
