@@ -55,7 +55,8 @@ inline real4 nearest_on_triangle(real4 p, real4 a, real4 b, real4 c, int* featur
 // each counted once (a flat face crossed by a point probe gives a continuous force):
 //   face: always;
 //   edge: only when the neighbour across it (the triangle (b, a, opposite)) has its nearest point
-//         on the same edge too, and only in the edge's owner (owner bits 3–5: edge ab, bc, ca);
+//         on the same edge too (then only in the edge's owner, owner bits 3–5: edge ab, bc, ca)
+//         or at one of its two ends (then this triangle's point on the edge is the nearer);
 //   vertex: flagged (corner .w = 1) by every triangle whose nearest point it is, with the force
 //         in its owner only (owner bits 0–2); the gather keeps it only when all the vertex's
 //         triangles flag it (triangle_contact_force).
@@ -96,7 +97,8 @@ kernel void triangle_contact(global const real4* u, global const uint* cell_of, 
         const real4 xo = rest_position(cell_of[o], sy, sz, origin, h) + xyz0(u[o]);
         int neighbour;
         nearest_on_triangle(c, x[(k + 1) % 3], x[k], xo, &neighbour);
-        counts = neighbour == 4 && ((own >> (3 + k)) & 1);
+        // the same edge (counted by its owner), or an end of it (then this point is nearer)
+        counts = (neighbour == 4 && ((own >> (3 + k)) & 1)) || neighbour == 1 || neighbour == 2;
       }
       if (counts && feature >= 1 && feature <= 3) {  // a vertex: flagged; the force in its owner only
         const int k = feature - 1;

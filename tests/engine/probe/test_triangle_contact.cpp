@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 
 #include "engine/error.hpp"
@@ -198,6 +199,8 @@ TEST(TriangleContact, SphereOnTrianglesFollowsHertz) {
   IndenterSpec ball = point_probe(R);
   s.indenters.push_back(ball);
   s.probe = test::press_at(0.5 * n * h, 0.5 * n * h, depth, 4);
+  if (const char* m = std::getenv("TRI_MAX_STEPS")) s.stop.max_steps = std::atoi(m);
+  if (const char* m = std::getenv("TRI_K")) s.indenters[0].contact_stiffness = std::atof(m);
   const ProbeResult r = test::run_probe(s);
   ASSERT_EQ(r.presses.size(), 1u);
   EXPECT_EQ(r.unconverged_increments, 0);
@@ -205,9 +208,9 @@ TEST(TriangleContact, SphereOnTrianglesFollowsHertz) {
     if (p.depth_m == 0) continue;
     const double hertz = 4.0 / 3 * Estar * std::sqrt(R) * std::pow(p.depth_m, 1.5);
     std::printf("hertz (triangles) depth %.3f mm  F %.5g N  Hertz %.5g N  ratio %.3f  contact %lld  area %.2f mm2 "
-                "(pi a2 %.2f)  steps %lld\n",
+                "(pi a2 %.2f)  steps %lld residual %.3g\n",
                 1e3 * p.depth_m, p.press_force_n, hertz, p.press_force_n / hertz, (long long)p.contact_elements,
-                1e6 * p.contact_area_m2, 1e6 * M_PI * R * p.depth_m, (long long)p.steps);
+                1e6 * p.contact_area_m2, 1e6 * M_PI * R * p.depth_m, (long long)p.steps, p.residual);
     EXPECT_NEAR(p.press_force_n / hertz, 1.0, 0.10) << "at depth " << p.depth_m << " m";
   }
   const Vec3 F = r.presses[0].samples.back().force_n;
