@@ -51,23 +51,16 @@ inline real4 nearest_on_triangle(real4 p, real4 a, real4 b, real4 c, int* featur
   return (real4)(1 - v - w, v, w, 0);
 }
 
-// Contact points are the local minima of the distance from the sphere's centre over the surface,
-// each counted once (a flat face crossed by a point probe gives a continuous force):
-//   face: always;
-//   edge: only when the neighbour across it (the triangle (b, a, opposite)) has its nearest point
-//         on the same edge too (then only in the edge's owner, owner bits 3–5: edge ab, bc, ca)
-//         or at one of its two ends (then this triangle's point on the edge is the nearer);
-//   vertex: flagged (corner .w = 1) by every triangle whose nearest point it is, with the force
-//         in its owner only (owner bits 0–2); the gather keeps it only when all the vertex's
-//         triangles flag it (triangle_contact_force).
-// The sphere overlaps where its nearest point p is within r. In front of the face the penetration
-// is r − |p − c| along (p − c)/|p − c|; a centre that has passed behind a face pushes along the
-// inward normal with r + |p − c| (the force keeps growing: a probe pressed in increments below
-// its radius cannot slip through). The force k_p·depth·n (on the tissue) goes to the corners by
-// weight.
+// Every triangle the sphere overlaps (its nearest point p within r) pushes on its own: a penalty
+// potential ½·k_p·depth² per triangle, smooth in the vertex positions, so the total force is
+// continuous as the contact moves over faces, edges and vertices (a contact at a shared edge or
+// vertex is felt by each triangle there: the penalty is up to that many times stiffer there, the
+// force still the tissue's; docs/PROBING.md). In front of the face the penetration is r − |p − c|
+// along (p − c)/|p − c|; a centre that has passed behind a face pushes along the inward normal
+// with r + |p − c| (the force keeps growing: a probe pressed in increments below its radius cannot
+// slip through). The force k_p·depth·n (on the tissue) goes to the corners by weight.
 kernel void triangle_contact(global const real4* u, global const uint* cell_of, int sy, int sz, real4 origin,
-                             real h, global const uint* triangles, global const uint* opposite,
-                             global const uchar* owner, uint n_triangles, real frame_sign,
+                             real h, global const uint* triangles, uint n_triangles, real frame_sign,
                              global const real* indenters, real t, global real4* corner_out) {
   const uint tr = get_global_id(0);
   if (tr >= n_triangles) return;
@@ -79,10 +72,9 @@ kernel void triangle_contact(global const real4* u, global const uint* cell_of, 
   const real4 normal = frame_sign * cross(x[1] - x[0], x[2] - x[0]);  // outward (lattice frame)
   const real normal_len = length(normal);
   const real4 outward = normal_len > 0 ? normal / normal_len : (real4)(0);
-  const uchar own = owner[tr];
   for (int i = 0; i < VB_INDENTERS; ++i) {
     global const real* ind = indenters + VB_IND_STRIDE * i;
-    real4 force = (real4)(0), w = (real4)(0), flag = (real4)(0);
+    real4 force = (real4)(0), w = (real4)(0);
     if (uses_triangles(ind)) {
       const real4 c = indenter_position(ind, t);
       int feature;
@@ -90,22 +82,7 @@ kernel void triangle_contact(global const real4* u, global const uint* cell_of, 
       const real4 p = w.x * x[0] + w.y * x[1] + w.z * x[2];
       const real4 d = xyz0(p - c);
       const real dist = length(d), r = ind[3];
-      int counts = dist < r;
-      if (counts && feature >= 4) {  // an edge: a local minimum only if the neighbour agrees
-        const int k = feature - 4;
-        const uint o = opposite[3 * tr + k];
-        const real4 xo = rest_position(cell_of[o], sy, sz, origin, h) + xyz0(u[o]);
-        int neighbour;
-        nearest_on_triangle(c, x[(k + 1) % 3], x[k], xo, &neighbour);
-        // the same edge (counted by its owner), or an end of it (then this point is nearer)
-        counts = (neighbour == 4 && ((own >> (3 + k)) & 1)) || neighbour == 1 || neighbour == 2;
-      }
-      if (counts && feature >= 1 && feature <= 3) {  // a vertex: flagged; the force in its owner only
-        const int k = feature - 1;
-        flag = (real4)(k == 0, k == 1, k == 2, 0);
-        counts = (own >> k) & 1;
-      }
-      if (counts) {
+      if (dist < r) {
         const int behind = feature == 0 && dot3(d, outward) > 0;  // centre behind the face
         const real depth = behind || dist == 0 ? r + dist : r - dist;
         const real4 n = behind || dist == 0 ? -outward : d / dist;
@@ -113,24 +90,18 @@ kernel void triangle_contact(global const real4* u, global const uint* cell_of, 
       }
     }
     global real4* out = corner_out + 3 * ((size_t)i * n_triangles + tr);
-    out[0] = w.x * force + (real4)(0, 0, 0, flag.x);
-    out[1] = w.y * force + (real4)(0, 0, 0, flag.y);
-    out[2] = w.z * force + (real4)(0, 0, 0, flag.z);
+    out[0] = w.x * force;
+    out[1] = w.y * force;
+    out[2] = w.z * force;
   }
 }
 
-// Force of triangle-contact indenter i on element e (N): the sum of the corners it is, its
-// vertex contact (flagged corners, .w = 1) only when every triangle at it flagged it.
+// Force of triangle-contact indenter i on element e (N): the sum of the corners it is.
 inline real4 triangle_contact_force(uint e, int i, global const real4* corner_force, global const uint* tri_start,
                                     global const uint* tri_corner, uint n_tri) {
-  real4 f = (real4)(0), at_vertex = (real4)(0);
+  real4 f = (real4)(0);
   global const real4* forces = corner_force + 3 * (size_t)i * n_tri;
-  const uint first = tri_start[e], last = tri_start[e + 1];
-  for (uint k = first; k < last; ++k) {
-    const real4 c = forces[tri_corner[k]];
-    if (c.w != 0) at_vertex += c; else f += c;
-  }
-  if (at_vertex.w == (real)(last - first)) f += at_vertex;
+  for (uint k = tri_start[e]; k < tri_start[e + 1]; ++k) f += forces[tri_corner[k]];
   return xyz0(f);
 }
 

@@ -139,7 +139,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
             "the body is the union of complete dual cells (docs/SURFACE.md): it needs parts two elements thick");
     penalty = triangle_contact_penalty(scene, lattice, el, surface_);
     tri_triangles_ = surface_.triangles.size();
-    device_bytes_ += tri_triangles_ * (3 * 4 + 3 * 4 + 1 + 3 * 4) + (n_ + 1) * 4 +
+    device_bytes_ += tri_triangles_ * (3 * 4 + 3 * 4) + (n_ + 1) * 4 +
                      3 * tri_triangles_ * scene.indenters.size() * 4 * real_size_;
   }
   contact_stiffness_n_m_ = penalty.stiffness_n_m;
@@ -898,16 +898,14 @@ void Simulator::make_triangle_contact_buffers() {
     return cl::Buffer(cl_.context, flags_ro, v.size() * sizeof(v[0]), const_cast<void*>(static_cast<const void*>(v.data())));
   };
   tri_elements_ = buffer(m.triangles);
-  tri_owner_ = buffer(m.owner);
-  tri_opposite_ = buffer(m.opposite);
   tri_start_ = buffer(m.start);
   tri_corner_ = buffer(m.corner);
   const std::size_t corners = 3 * tri_triangles_ * std::max<std::size_t>(1, scene_.indenters.size());
   std::vector<char> zeros(corners * 4 * real_size_, 0);
   corner_force_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, zeros.size(), zeros.data());
 
-  // kernels/triangle_contact.cl: u, cell_of, sy, sz, origin, h, triangles, opposite corners, owner,
-  // count, frame sign, indenters, t, corner forces
+  // kernels/triangle_contact.cl: u, cell_of, sy, sz, origin, h, triangles, count, frame sign,
+  // indenters, t, corner forces
   tri_kernel_ = cl::Kernel(program_, "triangle_contact");
   tri_kernel_.setArg(1, cell_);
   tri_kernel_.setArg(2, cl_int(stride_y_));
@@ -915,12 +913,10 @@ void Simulator::make_triangle_contact_buffers() {
   set_world_vector(tri_kernel_, 4, lattice_.origin_m);
   set_real(tri_kernel_, 5, lattice_.spacing_m);
   tri_kernel_.setArg(6, tri_elements_);
-  tri_kernel_.setArg(7, tri_opposite_);
-  tri_kernel_.setArg(8, tri_owner_);
-  tri_kernel_.setArg(9, cl_uint(tri_triangles_));
-  set_real(tri_kernel_, 10, lattice_.rotation.determinant() < 0 ? -1.0 : 1.0);  // outward in the lattice frame
-  tri_kernel_.setArg(11, indenters_);
-  tri_kernel_.setArg(13, corner_force_);
+  tri_kernel_.setArg(7, cl_uint(tri_triangles_));
+  set_real(tri_kernel_, 8, lattice_.rotation.determinant() < 0 ? -1.0 : 1.0);  // outward in the lattice frame
+  tri_kernel_.setArg(9, indenters_);
+  tri_kernel_.setArg(11, corner_force_);
   // The stepping and check kernels end with VB_TRI_PARAMS: corner forces, CSR start, corners, count.
   for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_, &check_}) {
     if (!(*k)()) continue;
@@ -935,7 +931,7 @@ void Simulator::make_triangle_contact_buffers() {
 void Simulator::enqueue_triangle_contact(const cl::Buffer& u, double t_s) {
   if (!tri_contact_) return;
   tri_kernel_.setArg(0, u);
-  set_real(tri_kernel_, 12, t_s);
+  set_real(tri_kernel_, 10, t_s);
   const std::size_t wg = kCheckWorkGroup;
   launch(tri_kernel_, cl::NDRange((tri_triangles_ + wg - 1) / wg * wg), cl_.info.is_gpu ? cl::NDRange(wg) : cl::NullRange);
 }
@@ -952,11 +948,10 @@ std::vector<double> Simulator::triangle_contact_forces_n() {
     cl_.queue.enqueueReadBuffer(corner_force_, CL_TRUE, 0, count * sizeof(float), f.data());
     std::copy(f.begin(), f.end(), raw.begin());
   }
-  std::vector<double> out(count);
+  std::vector<double> out(3 * (count / 4));
   for (std::size_t k = 0; k < count / 4; ++k) {
     const Vec3 w = lattice_.rotation * Vec3(raw[4 * k], raw[4 * k + 1], raw[4 * k + 2]);
-    for (int c = 0; c < 3; ++c) out[4 * k + c] = w[c];
-    out[4 * k + 3] = raw[4 * k + 3];
+    for (int c = 0; c < 3; ++c) out[3 * k + c] = w[c];
   }
   return out;
 }

@@ -143,8 +143,7 @@ class Simulator {
   /// triangle contact only: the surface mesh it acts on
   const SurfaceMesh& contact_surface_mesh() const { return surface_; }
   /// Triangle contact only: the forces on the tissue at the current state, per indenter, triangle
-  /// and corner (4 reals each: N, world frame, zero where it does not touch; then 1 where the
-  /// contact is at that corner's vertex, which counts only if every triangle there says so), as
+  /// and corner (3 reals each, N, world frame; zero where it does not touch), as
   /// kernels/triangle_contact.cl computes them; for tests.
   std::vector<double> triangle_contact_forces_n();
   /// kernel launches per projection of the volume constraint: 1 (volume_project) or 2
@@ -249,7 +248,7 @@ class Simulator {
   bool tri_contact_ = false;
   std::size_t tri_triangles_ = 0;
   std::vector<double> contact_stiffness_n_m_;
-  cl::Buffer tri_elements_, tri_opposite_, tri_owner_, tri_start_, tri_corner_, corner_force_;
+  cl::Buffer tri_elements_, tri_start_, tri_corner_, corner_force_;
   cl::Kernel tri_kernel_;
 };
 

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
-#include <utility>
 
 #include "engine/error.hpp"
 #include "engine/sim/time_step.hpp"
@@ -52,27 +50,10 @@ TriangleContactMesh triangle_contact_mesh(const SurfaceMesh& mesh, std::size_t n
   TriangleContactMesh m;
   const std::size_t T = mesh.triangles.size();
   m.triangles.resize(3 * T);
-  m.owner.assign(T, 0);
-  std::vector<std::uint32_t> vertex_owner(mesh.vertex_count(), std::uint32_t(T));
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> edge_owner, third;  // third: of the directed edge's triangle
-  for (std::uint32_t t = 0; t < T; ++t)
-    for (int c = 0; c < 3; ++c) {
-      const std::uint32_t a = mesh.triangles[t][c], b = mesh.triangles[t][(c + 1) % 3];
-      vertex_owner[a] = std::min(vertex_owner[a], t);
-      edge_owner.try_emplace({std::min(a, b), std::max(a, b)}, t);  // t ascends: the first is the lowest
-      third[{a, b}] = mesh.triangles[t][(c + 2) % 3];
-    }
-  m.opposite.resize(3 * T);
   m.start.assign(n + 1, 0);
-  for (std::uint32_t t = 0; t < T; ++t)
+  for (std::size_t t = 0; t < T; ++t)
     for (int c = 0; c < 3; ++c) {
-      const std::uint32_t a = mesh.triangles[t][c], b = mesh.triangles[t][(c + 1) % 3];
-      if (vertex_owner[a] == t) m.owner[t] |= std::uint8_t(1u << c);
-      if (edge_owner.at({std::min(a, b), std::max(a, b)}) == t) m.owner[t] |= std::uint8_t(1u << (3 + c));
-      const auto across = third.find({b, a});  // closed, oriented: the neighbour runs the edge backwards
-      require(across != third.end(), "the surface mesh is not closed at an edge", "indenter (triangle contact)");
-      m.opposite[3 * t + c] = mesh.element_of_vertex[across->second];
-      m.triangles[3 * t + c] = mesh.element_of_vertex[a];
+      m.triangles[3 * t + c] = mesh.element_of_vertex[mesh.triangles[t][c]];
       ++m.start[m.triangles[3 * t + c] + 1];
     }
   for (std::size_t e = 0; e < n; ++e) m.start[e + 1] += m.start[e];

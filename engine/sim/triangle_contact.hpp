@@ -37,12 +37,6 @@ TriangleContactPenalty triangle_contact_penalty(const Scene& scene, const Lattic
 /// The surface mesh as the kernels read it.
 struct TriangleContactMesh {
   std::vector<std::uint32_t> triangles;  ///< 3 element ids per triangle, the mesh's order
-  /// per triangle: bits 0–2 it owns vertex a, b, c; bits 3–5 it owns edge ab, bc, ca. The lowest
-  /// numbered triangle at a mesh vertex or edge owns it, so a contact point there counts once
-  /// (kernels/triangle_contact.cl).
-  std::vector<std::uint8_t> owner;
-  /// per triangle and edge (ab, bc, ca): the element at the third corner of the triangle across it
-  std::vector<std::uint32_t> opposite;
   std::vector<std::uint32_t> start;   ///< per element (n + 1): its range in `corner`
   std::vector<std::uint32_t> corner;  ///< 3·triangle + corner, grouped by element
 };

@@ -4,10 +4,7 @@
 // and sum to the indenter's reaction; a sphere still follows Hertz; scenes without it build none of it.
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cmath>
-#include <cstdlib>
-#include <map>
 
 #include "engine/error.hpp"
 #include "engine/sim/time_step.hpp"
@@ -44,37 +41,21 @@ const double kX0 = 4.5 * kH, kY0 = 4.5 * kH;
 
 struct Touch {
   int triangles = 0;          // triangles with a force
-  Vec3 total = Vec3::Zero();  // on the tissue, gathered per element as the kernels do
+  Vec3 total = Vec3::Zero();  // on the tissue
   std::vector<Vec3> corners;  // the corner forces of the touched triangles
 };
 
-// Corner forces of Simulator::triangle_contact_forces_n (indenter 0): a vertex contact (flagged
-// corners) counts only where every triangle at the element flagged it.
-Touch touched(const std::vector<double>& f, const SurfaceMesh& mesh) {
+// Corner forces of Simulator::triangle_contact_forces_n (indenter 0).
+Touch touched(const std::vector<double>& f) {
   Touch t;
-  std::map<std::uint32_t, std::array<double, 5>> flagged;  // element: corners, flagged, flagged force
-  for (std::size_t tr = 0; tr < mesh.triangles.size(); ++tr) {
+  for (std::size_t tr = 0; tr < f.size() / 9; ++tr) {
     Vec3 c[3];
     double size = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double* q = &f[4 * (3 * tr + k)];
-      c[k] = Vec3(q[0], q[1], q[2]);
-      size += c[k].norm();
-      auto& e = flagged[mesh.element_of_vertex[mesh.triangles[tr][k]]];
-      e[0] += 1;
-      if (q[3] != 0) {
-        e[1] += 1;
-        for (int j = 0; j < 3; ++j) e[2 + j] += q[j];
-      } else {
-        t.total += c[k];
-      }
-    }
+    for (int k = 0; k < 3; ++k) c[k] = Vec3(f[9 * tr + 3 * k], f[9 * tr + 3 * k + 1], f[9 * tr + 3 * k + 2]), size += c[k].norm();
     if (size == 0) continue;
     ++t.triangles;
-    for (const Vec3& v : c) t.corners.push_back(v);
+    for (const Vec3& v : c) t.total += v, t.corners.push_back(v);
   }
-  for (const auto& [e, v] : flagged)
-    if (v[1] == v[0]) t.total += Vec3(v[2], v[3], v[4]);
   return t;
 }
 
@@ -90,7 +71,7 @@ TEST(TriangleContact, ForcesSplitByBarycentricWeights) {
 
   // Over a triangle's centroid: one triangle, three equal shares, pushing down.
   sim.place_indenter(0, Vec3(kX0 + 2 * kH / 3, kY0 + kH / 3, kTop + r - depth));
-  Touch t = touched(sim.triangle_contact_forces_n(), sim.contact_surface_mesh());
+  Touch t = touched(sim.triangle_contact_forces_n());
   ASSERT_EQ(t.triangles, 1);
   EXPECT_NEAR(t.total.z(), -F, 1e-12 * F);
   for (const Vec3& c : t.corners) {
@@ -101,40 +82,41 @@ TEST(TriangleContact, ForcesSplitByBarycentricWeights) {
   EXPECT_NEAR(check.indenter_force_n[0].z(), F, 1e-12 * F) << "the reaction is minus the sum of the vertex forces";
   EXPECT_EQ(check.contact_elements[0], 3);
 
-  // Over a vertex (an element centre): its six triangles all reach it there; it counts once, the
-  // whole force on that vertex.
+  // Over a vertex (an element centre): each of its six triangles reaches it there and gives it
+  // the whole of its force (weights 1, 0, 0): the vertex carries all of it, six times k_p·δ (the
+  // penalty is stiffer at a vertex; the force of a relaxed press is still the tissue's).
   sim.place_indenter(0, Vec3(kX0, kY0, kTop + r - depth));
-  t = touched(sim.triangle_contact_forces_n(), sim.contact_surface_mesh());
-  ASSERT_EQ(t.triangles, 1);
+  t = touched(sim.triangle_contact_forces_n());
+  ASSERT_EQ(t.triangles, 6);
   int loaded = 0;
   for (const Vec3& c : t.corners)
     if (c.norm() > 1e-9 * F) {
       ++loaded;
       EXPECT_NEAR(c.z(), -F, 1e-9 * F);
     }
-  EXPECT_EQ(loaded, 1);
-  EXPECT_NEAR(t.total.z(), -F, 1e-12 * F);
+  EXPECT_EQ(loaded, 6);
   check = sim.check();
-  EXPECT_NEAR(check.indenter_force_n[0].z(), F, 1e-12 * F);
-  EXPECT_EQ(check.contact_elements[0], 1);
+  EXPECT_NEAR(check.indenter_force_n[0].z(), 6 * F, 1e-9 * F);
+  EXPECT_NEAR(t.total.z(), -6 * F, 1e-9 * F);
+  EXPECT_EQ(check.contact_elements[0], 1) << "one element carries it";
 
-  // Over the middle of an edge shared by two triangles: counted once, half to each end.
+  // Over the middle of an edge: its two triangles, each half to either end.
   sim.place_indenter(0, Vec3(kX0 + 0.5 * kH, kY0, kTop + r - depth));
-  t = touched(sim.triangle_contact_forces_n(), sim.contact_surface_mesh());
-  ASSERT_EQ(t.triangles, 1);
+  t = touched(sim.triangle_contact_forces_n());
+  ASSERT_EQ(t.triangles, 2);
   loaded = 0;
   for (const Vec3& c : t.corners)
     if (c.norm() > 1e-9 * F) {
       ++loaded;
       EXPECT_NEAR(c.z(), -F / 2, 1e-9 * F);
     }
-  EXPECT_EQ(loaded, 2);
-  EXPECT_NEAR(t.total.z(), -F, 1e-12 * F);
-  EXPECT_NEAR(sim.check().indenter_force_n[0].z(), F, 1e-12 * F);
+  EXPECT_EQ(loaded, 4);
+  check = sim.check();
+  EXPECT_NEAR(check.indenter_force_n[0].z(), 2 * F, 1e-9 * F);
 
   // Above the surface: nothing.
   sim.place_indenter(0, Vec3(kX0 + 2 * kH / 3, kY0 + kH / 3, kTop + 1.01 * r));
-  EXPECT_EQ(touched(sim.triangle_contact_forces_n(), sim.contact_surface_mesh()).triangles, 0);
+  EXPECT_EQ(touched(sim.triangle_contact_forces_n()).triangles, 0);
   EXPECT_EQ(sim.check().contact_elements[0], 0);
 }
 
@@ -159,7 +141,7 @@ Press press(IndenterSpec::Surface surface, double x, double y, double r, double 
   for (const PressSample& q : res.presses.at(0).samples) p.depth_mm.push_back(1e3 * q.depth_m), p.force_n.push_back(q.press_force_n);
   if (sim.triangle_contact()) {
     const Vec3 reaction = sim.check().indenter_force_n[0];
-    p.reaction_vs_sum = (reaction + touched(sim.triangle_contact_forces_n(), sim.contact_surface_mesh()).total).norm() / reaction.norm();
+    p.reaction_vs_sum = (reaction + touched(sim.triangle_contact_forces_n()).total).norm() / reaction.norm();
   }
   return p;
 }
@@ -197,10 +179,14 @@ TEST(TriangleContact, SphereOnTrianglesFollowsHertz) {
   Scene s = test::probe_block(n, n, nz, h, kE);
   const double R = 9 * h, depth = 1.0 * h;
   IndenterSpec ball = point_probe(R);
+  // A softer penalty and a looser equilibrium than the vertex test: relaxation with the penalty's
+  // heavier surface elements stalls near a residual of 1e-5 (contacts entering and leaving at
+  // |p − c| = r); at 5e-5 the force has settled to 0.1% (docs/VALIDATION.md, issue 9).
+  ball.contact_stiffness = 0.2;
   s.indenters.push_back(ball);
-  s.probe = test::press_at(0.5 * n * h, 0.5 * n * h, depth, 4);
-  if (const char* m = std::getenv("TRI_MAX_STEPS")) s.stop.max_steps = std::atoi(m);
-  if (const char* m = std::getenv("TRI_K")) s.indenters[0].contact_stiffness = std::atof(m);
+  s.stop.equilibrium = 5e-5;
+  s.stop.max_steps = 6000;
+  s.probe = test::press_at(0.5 * n * h, 0.5 * n * h, depth, 2);
   const ProbeResult r = test::run_probe(s);
   ASSERT_EQ(r.presses.size(), 1u);
   EXPECT_EQ(r.unconverged_increments, 0);
