@@ -653,12 +653,21 @@ AnchorSpec read_anchor(const std::string& name, const Section& s) {
 }
 
 const NameTable<IndenterSpec::Kind> kIndenterKinds = {
-    {"sphere", IndenterSpec::Kind::Sphere, {"kind", "radius", "start", "velocity", "travel_time", "path", "contact", "friction"}},
-    {"plate", IndenterSpec::Kind::Plate, {"kind", "start", "normal", "velocity", "travel_time", "path", "contact", "friction"}},
+    {"sphere", IndenterSpec::Kind::Sphere, {"kind", "radius", "start", "velocity", "travel_time", "path", "contact", "friction",
+                   "contact_surface", "contact_stiffness"}},
+    {"plate", IndenterSpec::Kind::Plate, {"kind", "start", "normal", "velocity", "travel_time", "path", "contact", "friction",
+                   "contact_surface", "contact_stiffness"}},
     {"cylinder", IndenterSpec::Kind::Cylinder,
-     {"kind", "radius", "axis", "start", "velocity", "travel_time", "path", "contact", "friction"}},
+     {"kind", "radius", "axis", "start", "velocity", "travel_time", "path", "contact", "friction",
+                   "contact_surface", "contact_stiffness"}},
     {"capsule", IndenterSpec::Kind::Capsule,
-     {"kind", "radius", "axis", "length", "start", "velocity", "travel_time", "path", "contact", "friction"}},
+     {"kind", "radius", "axis", "length", "start", "velocity", "travel_time", "path", "contact", "friction",
+                   "contact_surface", "contact_stiffness"}},
+};
+
+const NameTable<IndenterSpec::Surface> kContactSurfaces = {
+    {"vertices", IndenterSpec::Surface::Vertices, {}},
+    {"triangles", IndenterSpec::Surface::Triangles, {}},
 };
 
 const NameTable<IndenterSpec::Contact> kContacts = {
@@ -681,6 +690,21 @@ IndenterSpec read_indenter(const Section& s, const std::string& scene_dir) {
   i.friction = s.non_negative("friction").value_or(0.0);
   if (i.friction > 0 && i.contact != IndenterSpec::Contact::Push)
     s.fail("friction", "applies to contact = \"push\" only", "'slide' is frictionless and 'stick' has no slip: remove 'friction'");
+  if (const auto* n = s.named("contact_surface", kContactSurfaces)) i.contact_surface = n->value;
+  if (const auto k = s.positive("contact_stiffness")) {
+    if (i.contact_surface != IndenterSpec::Surface::Triangles)
+      s.fail("contact_stiffness", "is the penalty of triangle contact", "set contact_surface = \"triangles\" or remove it");
+    i.contact_stiffness = *k;
+  }
+  if (i.contact_surface == IndenterSpec::Surface::Triangles) {
+    if (i.kind != IndenterSpec::Kind::Sphere)
+      s.fail("contact_surface", "\"triangles\" is built for spheres only (a point probe)",
+             "use kind = \"sphere\", or contact_surface = \"vertices\" for plates, cylinders and capsules");
+    if (i.contact != IndenterSpec::Contact::Push)
+      s.fail("contact", "triangle contact is unilateral (push)", "remove 'contact' or use contact_surface = \"vertices\"");
+    if (i.friction > 0)
+      s.fail("friction", "triangle contact is frictionless", "remove 'friction' or use contact_surface = \"vertices\"");
+  }
   if (const auto path = s.text("path")) {
     for (const char* key : {"start", "velocity", "travel_time"})
       if (s.find(key)) s.fail(key, "a trajectory ('path') gives the positions already", "remove '" + std::string(key) + "'");

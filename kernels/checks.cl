@@ -12,6 +12,8 @@
 // 3 contact elements, 4 their contact area (m², per-element shares), 5 the sum of their normal
 // forces |f_n| (N), 6 peak contact pressure (Pa, max), 7 deepest penetration of a free element
 // into the tube (m, max).
+// With VB_TRI_CONTACT a triangle-contact indenter's slots hold minus the forces it exerts through
+// the surface triangles (kernels/triangle_contact.cl) and its count of elements that carry some.
 // With VB_RELAX (dynamic relaxation, kernels/relax.cl) four more sums follow: Rayleigh quotients,
 // each ≥ the lowest mode's ω², that the host sets the damping from (Underwood). One is of the
 // displacement u from rest (the lattice force is zero there), one of the change Δu since the previous
@@ -68,7 +70,7 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
 #if VB_RELAX
                  , global const real* relax_scale, global real4* relax_prev
 #endif
-                 ) {
+                 VB_TRI_PARAMS) {
   local real s[VB_CHECK_SLOTS][VB_CHECK_WG];
   local int s_arg[VB_CHECK_WG];
   const uint e = get_global_id(0), l = get_local_id(0);
@@ -108,9 +110,25 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
 #if VB_VOLUME
       f -= volume_scalars[3] * volume_grad[e];
 #endif
+#if VB_TRI_CONTACT
+      // Triangle contact: the element's share of the penalty forces is part of its force; the
+      // indenter feels the opposite (the sum over elements is minus the sum of triangle forces).
+      for (int i = 0; i < VB_INDENTERS; ++i) {
+        if (!uses_triangles(indenters + VB_IND_STRIDE * i)) continue;
+        const real4 pushed = triangle_contact_force(e, i, corner_force, tri_start, tri_corner, n_tri);
+        f += pushed;
+        value[5 + 4 * i] = -pushed.x;
+        value[6 + 4 * i] = -pushed.y;
+        value[7 + 4 * i] = -pushed.z;
+        value[8 + 4 * i] = dot3(pushed, pushed) > 0 ? 1 : 0;
+      }
+#endif
 #if VB_INDENTERS
       const real4 x = rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui);
       for (int i = 0; i < VB_INDENTERS; ++i) {
+#if VB_TRI_CONTACT
+        if (uses_triangles(indenters + VB_IND_STRIDE * i)) continue;
+#endif
         torus_grip grip = {0};
         real4 reaction = contact_constrain(&f, x, indenters + VB_IND_STRIDE * i, t_force, h, &grip);
 #if VB_FRICTION

@@ -9,6 +9,7 @@
 //   -DVB_VOLUME=0|1   volume-preservation constraint on (kernels/volume.cl)
 //   -DVB_RELAX=0|1    dynamic relaxation (kernels/relax.cl): four more check slots
 //   -DVB_TORI=count, -DVB_TORUS_BASE=N, -DVB_FRICTION=0|1  the torus device (kernels/device_contact.cl)
+//   -DVB_TRI_CONTACT=0|1 some indenter touches the surface triangles (kernels/triangle_contact.cl)
 //   -DVB_REST_OFFSET=0|1  the rest state is not the lattice: element e rests at its voxel centre
 //                     plus rest_offset[e] (the unloaded reference state, docs/PHYSICS.md §13)
 //   -DVB_VOLUME_FOLD=0|1  Heun with the volume constraint, projections applied by the kernels that
@@ -78,8 +79,9 @@ inline void pending_v(real4* vj, real4 wg, VB_PENDING_PARAMS) {
 // 0–2 start (m), 3 radius (m; -1 for a plate), 4–6 plate normal into the tissue / cylinder and
 // capsule axis (unit), 8–10 velocity (m/s), 12 travel time (s), 13 contact: 0 push, 1 slide,
 // 2 stick, 14 kind: 0 sphere, 1 plate, 2 cylinder, 3 capsule, 15 capsule segment length (m),
-// 16 time t0 (s) at which the indenter is at `start`, 17 Coulomb friction μ (push contact);
-// 7, 11, 18 and 19 unused: new columns go at the end), the time forces are evaluated at, and
+// 16 time t0 (s) at which the indenter is at `start`, 17 Coulomb friction μ (push contact),
+// 18 contact surface: 0 vertices, 1 triangles (kernels/triangle_contact.cl), 19 its penalty
+// stiffness (N/m); 7 and 11 unused: new columns go at the end), the time forces are evaluated at, and
 // the time stage positions are projected at.
 // A 1-row placeholder when VB_INDENTERS is 0. Torus rows and their
 // inflation knots follow from VB_TORUS_BASE (kernels/device_contact.cl): the rigid-obstacle table.

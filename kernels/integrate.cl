@@ -10,10 +10,15 @@
 // Acceleration of free element e from its lattice force f (N): gravity, global damping and the
 // indenters' constraint added as static_force and acceleration add them.
 // `grip` collects the indenters' friction (device_contact.cl), turned into m/s² like the torus's.
+// With VB_TRI_CONTACT the triangle-contact forces (triangle_contact.cl, computed for the same u
+// just before this kernel) are added; VB_TRI_PARAMS is empty otherwise.
 inline real4 acceleration_from(real4 f, uint e, real4 ui, real4 vi, VB_LATTICE_PARAMS,
-                               global const real* indenters, real t, torus_grip* grip) {
+                               global const real* indenters, real t, torus_grip* grip VB_TRI_PARAMS) {
 #if VB_GRAVITY
   f += xyz0(gravity) / ui.w;
+#endif
+#if VB_TRI_CONTACT
+  f += triangle_contact_all(e, indenters, corner_force, tri_start, tri_corner, n_tri);  // computed for this u
 #endif
 #if VB_GLOBAL_DAMPING
   f -= damping * xyz0(vi) / ui.w;
@@ -26,9 +31,9 @@ inline real4 acceleration_from(real4 f, uint e, real4 ui, real4 vi, VB_LATTICE_P
 }
 
 inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                          VB_LATTICE_PARAMS, global const real* indenters, real t, torus_grip* grip) {
+                          VB_LATTICE_PARAMS, global const real* indenters, real t, torus_grip* grip VB_TRI_PARAMS) {
   return acceleration_from(lattice_force(e, ui, vi, u, v, VB_LATTICE_ARGS), e, ui, vi, VB_LATTICE_ARGS,
-                           indenters, t, grip);
+                           indenters, t, grip VB_TRI_ARGS);
 }
 
 // Ends a stage: moves an element that ended inside an indenter or a torus tube back onto its
@@ -48,9 +53,9 @@ inline void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_o
 
 // The end of an explicit stage of free element e once its lattice force f is known.
 inline void explicit_update(uint e, real4* ui, real4* vi, real4 f, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS,
-                            real dt, int symplectic) {
+                            real dt, int symplectic VB_TRI_PARAMS) {
   torus_grip grip = {0};  // friction of the indenters and tori (no-op without VB_FRICTION)
-  real4 a = acceleration_from(f, e, *ui, *vi, VB_LATTICE_ARGS, indenters, t_force, &grip);
+  real4 a = acceleration_from(f, e, *ui, *vi, VB_LATTICE_ARGS, indenters, t_force, &grip VB_TRI_ARGS);
 #if VB_TORI
   const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
   torus_constrain_all(&a, X + xyz0(*ui), indenters, t_force, h, &grip);
@@ -66,9 +71,9 @@ inline void explicit_update(uint e, real4* ui, real4* vi, real4 f, VB_LATTICE_PA
 // The corrector's end for free element e once the lattice force f at (ũ, ṽ) is known: returns v',
 // moves ui to u'.
 inline real4 correct_update(uint e, real4* ui, real4 vi, real4 up, real4 vp, real4 f, VB_LATTICE_PARAMS,
-                            VB_INDENTER_PARAMS, real dt) {
+                            VB_INDENTER_PARAMS, real dt VB_TRI_PARAMS) {
   torus_grip grip = {0};
-  real4 a = acceleration_from(f, e, up, vp, VB_LATTICE_ARGS, indenters, t_force, &grip);
+  real4 a = acceleration_from(f, e, up, vp, VB_LATTICE_ARGS, indenters, t_force, &grip VB_TRI_ARGS);
 #if VB_TORI
   const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
   torus_constrain_all(&a, X + xyz0(up), indenters, t_force, h, &grip);
@@ -116,7 +121,7 @@ inline real4 split_lattice_force(int active, uint e, real4 ui, real4 vi, global 
 // projected state, its own included.
 inline void explicit_stage(global const real4* u, global const real4* v, global real4* u_out,
                            global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                           uint n, int symplectic, VB_PENDING_PARAMS) {
+                           uint n, int symplectic, VB_PENDING_PARAMS VB_TRI_PARAMS) {
   const uint e = get_global_id(0);
   if (e >= n) return;
   real4 ui = u[e], vi = v[e], wg = (real4)(0);
@@ -124,7 +129,7 @@ inline void explicit_stage(global const real4* u, global const real4* v, global 
   pending_v(&vi, wg, VB_PENDING_ARGS);
   if (ui.w != 0) {
     const real4 f = lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, 0, 26);
-    explicit_update(e, &ui, &vi, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, symplectic);
+    explicit_update(e, &ui, &vi, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, symplectic VB_TRI_ARGS);
   }
   u_out[e] = ui;
   v_out[e] = vi;
@@ -132,8 +137,8 @@ inline void explicit_stage(global const real4* u, global const real4* v, global 
 
 kernel void euler_step(global const real4* u, global const real4* v, global real4* u_out,
                        global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                       uint n) {
-  explicit_stage(u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1, VB_NO_PENDING);
+                       uint n VB_TRI_PARAMS) {
+  explicit_stage(u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1, VB_NO_PENDING VB_TRI_ARGS);
 }
 
 // With VB_VOLUME_FOLD (Heun with the volume constraint, kernels/volume.cl: volume_pending) the
@@ -150,7 +155,7 @@ kernel void euler_step(global const real4* u, global const real4* v, global real
 
 kernel VB_STEP_ATTR void heun_predict(global const real4* u, global const real4* v, global real4* u_pred,
                                       global real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                                      uint n VB_FOLD_PARAMS(state)) {
+                                      uint n VB_FOLD_PARAMS(state) VB_TRI_PARAMS) {
 #if VB_SPLIT > 1
   local real4 share[VB_SPLIT_WG];
   const uint e = split_element();
@@ -164,17 +169,17 @@ kernel VB_STEP_ATTR void heun_predict(global const real4* u, global const real4*
   }
   const real4 f = split_lattice_force(in && ui.w != 0, e, ui, vi, u, v, VB_LATTICE_ARGS, VB_FOLD_PENDING(state), share);
   if (!in || get_local_id(0) >= VB_SPLIT_PER) return;
-  if (ui.w != 0) explicit_update(e, &ui, &vi, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, 0);
+  if (ui.w != 0) explicit_update(e, &ui, &vi, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, 0 VB_TRI_ARGS);
   u_pred[e] = ui;
   v_pred[e] = vi;
 #else
-  explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0, VB_FOLD_PENDING(state));
+  explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0, VB_FOLD_PENDING(state) VB_TRI_ARGS);
 #endif
 }
 
 kernel VB_STEP_ATTR void heun_correct(global real4* u, global real4* v, global const real4* u_pred,
                                       global const real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS,
-                                      real dt, uint n VB_FOLD_PARAMS(state) VB_FOLD_PARAMS(pred)) {
+                                      real dt, uint n VB_FOLD_PARAMS(state) VB_FOLD_PARAMS(pred) VB_TRI_PARAMS) {
 #if VB_SPLIT > 1
   local real4 share[VB_SPLIT_WG];
   const uint e = split_element();
@@ -204,7 +209,7 @@ kernel VB_STEP_ATTR void heun_correct(global real4* u, global real4* v, global c
   if (ui.w == 0) return;
   const real4 f = lattice_force_pending(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, VB_FOLD_PENDING(pred), 0, 26);
 #endif
-  const real4 vn = correct_update(e, &ui, vi, up, vp, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt);
+  const real4 vn = correct_update(e, &ui, vi, up, vp, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt VB_TRI_ARGS);
   u[e] = ui;
   v[e] = vn;
 }

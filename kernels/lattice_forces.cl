@@ -205,6 +205,9 @@ inline real indenter_distance(real4 x, global const real* ind, real t, real4* n_
 // Stick: the element moves with the indenter, which carries all of its force.
 // Returns the part carried (force on the indenter, N) and removes it from f.
 inline real4 contact_constrain(real4* f, real4 x, global const real* ind, real t, real h, torus_grip* grip) {
+#if VB_TRI_CONTACT
+  if (ind[18] != 0) return (real4)(0);  // contact with the surface triangles (triangle_contact.cl)
+#endif
   real4 n;
   const real dist = indenter_distance(x, ind, t, &n);
   const int mode = (int)ind[13];
@@ -235,6 +238,9 @@ inline void contact_project_all(real4* ui, real4* vi, real4 X, global const real
   for (int i = 0; i < VB_INDENTERS; ++i) {
     global const real* ind = indenters + VB_IND_STRIDE * i;
     const int mode = (int)ind[13];
+#if VB_TRI_CONTACT
+    if (ind[18] != 0) continue;  // triangle contact: a force, not a projection
+#endif
     real4 n;
     const real dist = indenter_distance(X + xyz0(*ui), ind, t, &n);
     if (mode == 0 ? dist >= 0 : fabs(dist) > REAL_CONTACT_TOL * h) continue;

@@ -8,7 +8,7 @@
 // each check. Gravity still uses the real mass (u.w), so the equilibrium is the real one.
 kernel void relax_step(global const real4* u, global const real4* v, global real4* u_out,
                        global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                       uint n, global const real* relax_scale, real c) {
+                       uint n, global const real* relax_scale, real c VB_TRI_PARAMS) {
   const uint e = get_global_id(0);
   if (e >= n) return;
   real4 ui = u[e], vi = v[e];
@@ -16,7 +16,8 @@ kernel void relax_step(global const real4* u, global const real4* v, global real
     // acceleration() is f/m with the indenters' constraint (no global damping is compiled in);
     // m/m̃ turns it into f/m̃, then the fictitious damping.
     torus_grip grip = {0};  // on the acceleration, as in integrate.cl (the indenters' scaled here)
-    real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force, &grip) * relax_scale[e] - c * xyz0(vi);
+    real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force, &grip VB_TRI_ARGS) * relax_scale[e] -
+              c * xyz0(vi);
     grip.grip_n *= relax_scale[e];
 #if VB_TORI
     torus_constrain_all(&a, rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui), indenters, t_force, h, &grip);

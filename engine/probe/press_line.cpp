@@ -8,6 +8,7 @@
 #include "engine/error.hpp"
 #include "engine/probe/force_profile.hpp"
 #include "engine/probe/indenter_shape.hpp"
+#include "engine/probe/triangle_geometry.hpp"
 #include "engine/results/element_measures.hpp"
 #include "engine/sim/run.hpp"
 #include "engine/surface/surface_area.hpp"
@@ -58,12 +59,15 @@ std::vector<double> positions(const Lattice& lattice, const std::vector<double>&
   return x;
 }
 
-/// Travel along `dir` from `from` at which the indenter first touches an element at x (m): scanned
-/// in steps of `step` (shorter than the indenter and the spacing, so no element is stepped over),
-/// then bisected in the step where the nearest element's signed distance first drops to zero.
+/// Travel along `dir` from `from` at which the indenter first touches an element at x (m), or with
+/// triangle contact a surface triangle: scanned in steps of `step` (shorter than the indenter and
+/// the spacing, so no element is stepped over), then bisected in the step where the nearest
+/// element's (triangle's) signed distance first drops to zero.
 double first_touch(const IndenterSpec& ind, const Vec3& from, const Vec3& dir, const std::vector<double>& x,
-                   double reach, double step) {
+                   const SurfaceMesh& surface, double reach, double step) {
+  const bool triangles = ind.contact_surface == IndenterSpec::Surface::Triangles;
   const auto gap = [&](double s) {
+    if (triangles) return sphere_surface_gap_m(surface, x, from + s * dir, ind.radius_m);
     double g = INFINITY;
     for (std::size_t e = 0; e < x.size() / 3; ++e)
       g = std::min(g, indenter_signed_distance(ind, from + s * dir, Vec3(x[3 * e], x[3 * e + 1], x[3 * e + 2])));
@@ -88,6 +92,12 @@ ProbeResult run_press_line(const Scene& scene, const Lattice& lattice, const Ele
   require(p.indenter < scene.indenters.size(), "probe.indenter names no [[indenter]]", "probe.indenter");
   require(p.presses >= 1 && p.steps >= 1 && p.depth_m > 0, "probe needs presses ≥ 1, steps ≥ 1 and depth > 0", "probe");
   const IndenterSpec& ind = scene.indenters[p.indenter];
+  const bool triangles = ind.contact_surface == IndenterSpec::Surface::Triangles;
+  // A penalty probe placed deeper than its radius per increment could land behind the surface.
+  require(!triangles || p.depth_m / p.steps < ind.radius_m,
+          "the press increment (depth/steps = " + std::to_string(1e3 * p.depth_m / p.steps) +
+              " mm) is not smaller than the triangle-contact probe's radius (" + std::to_string(1e3 * ind.radius_m) + " mm)",
+          "probe.steps", "use more steps, so that each increment is below the radius");
   require(ind.path.empty(), "the probing indenter follows a recorded trajectory", "probe.indenter",
           "[probe] moves the indenter itself: remove its 'path'");
   const auto start_clock = std::chrono::steady_clock::now();
@@ -123,7 +133,7 @@ ProbeResult run_press_line(const Scene& scene, const Lattice& lattice, const Ele
       for (std::size_t e = 0; e < x0.size() / 3; ++e)
         reach = std::max(reach, (Vec3(x0[3 * e], x0[3 * e + 1], x0[3 * e + 2]) - start).norm());
       const double step = 0.5 * (ind.kind == IndenterSpec::Kind::Plate ? h : std::min(h, ind.radius_m));
-      const double touch = first_touch(ind, start, dir, x0, reach, step);
+      const double touch = first_touch(ind, start, dir, x0, surface, reach, step);
       require(std::isfinite(touch), "press " + std::to_string(k + 1) + " never touches the model", "probe.from",
               "start the presses beside the model and point 'direction' at it");
       start += touch * dir;
@@ -145,15 +155,20 @@ ProbeResult run_press_line(const Scene& scene, const Lattice& lattice, const Ele
       sample.steps = r.steps;
       sample.residual = r.residual;
       sample.converged = r.converged;
-      // Contact area: surface-area shares of the surface elements on the indenter's surface.
+      // Contact area: surface-area shares of the surface elements on the indenter's surface; with
+      // triangle contact the areas of the triangles the sphere overlaps.
       std::vector<double> u, v;
       sim.download(u, v);
       const std::vector<double> x = positions(lattice, u);
-      const std::vector<double> area = element_surface_area_m2(surface, x);
       const Vec3 at = start + sample.depth_m * dir;
-      for (std::size_t e = 0; e < area.size(); ++e)
-        if (area[e] > 0 && indenter_signed_distance(ind, at, Vec3(x[3 * e], x[3 * e + 1], x[3 * e + 2])) <= kContactTol * h)
-          sample.contact_area_m2 += area[e];
+      if (triangles) {
+        sample.contact_area_m2 = touched_triangle_area_m2(surface, x, at, ind.radius_m, 0.0);
+      } else {
+        const std::vector<double> area = element_surface_area_m2(surface, x);
+        for (std::size_t e = 0; e < area.size(); ++e)
+          if (area[e] > 0 && indenter_signed_distance(ind, at, Vec3(x[3 * e], x[3 * e + 1], x[3 * e + 2])) <= kContactTol * h)
+            sample.contact_area_m2 += area[e];
+      }
       // Folded elements: the spring lattice has no resistance to inversion, and a press that
       // crushes the layer under the indenter can push an element through its neighbours into a
       // softer, folded state (docs/PROBING.md, "Validity"); its force is not the tissue's.

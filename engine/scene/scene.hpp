@@ -122,6 +122,14 @@ struct IndenterSpec {
   Kind kind = Kind::Sphere;
   Contact contact = Contact::Push;
   double friction = 0;               ///< Coulomb coefficient μ of push contact (0: frictionless)
+  /// what the indenter touches (docs/PROBING.md): the surface elements (vertices: a constraint)
+  /// or the surface triangles (a penalty force split to each triangle's vertices by the
+  /// barycentric weights of the contact point: a point probe between vertices)
+  enum class Surface { Vertices, Triangles };
+  Surface contact_surface = Surface::Vertices;
+  /// triangles: the penalty stiffness k_p as a multiple of the stiffest free element's Gershgorin
+  /// row stiffness (engine/sim/triangle_contact.hpp)
+  double contact_stiffness = 1;
   double radius_m = 0;               ///< sphere, cylinder, capsule radius (m)
   double length_m = 0;               ///< capsule: length of its axis segment (m)
   /// sphere centre / a point on the plate / centre of the cylinder's flat end / the capsule's tip

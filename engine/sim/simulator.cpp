@@ -8,6 +8,7 @@
 #include "engine/device/torus.hpp"
 #include "engine/error.hpp"
 #include "engine/sim/kernel_tables.hpp"
+#include "engine/sim/triangle_contact.hpp"
 #include "engine/surface/enclosed_volume.hpp"
 #include "engine/surface/surface_area.hpp"
 
@@ -130,6 +131,21 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
             "the body is the union of complete dual cells (docs/SURFACE.md): it needs parts two elements thick");
     device_bytes_ += estimated_volume_device_bytes(n_, mesh.surface_element_count, mesh.triangles.size(), precision_);
   }
+  // Triangle contact (kernels/triangle_contact.cl): the surface mesh and the penalty stiffness.
+  check_triangle_contact(scene);
+  tri_contact_ = uses_triangle_contact(scene);
+  TriangleContactPenalty penalty;
+  penalty.stiffness_n_m.assign(scene.indenters.size(), 0.0);
+  if (tri_contact_) {
+    if (!volume_) surface_ = build_surface(lattice);
+    require(!surface_.triangles.empty(), "the model has no closed surface for triangle contact", "indenter",
+            "the body is the union of complete dual cells (docs/SURFACE.md): it needs parts two elements thick");
+    penalty = triangle_contact_penalty(scene, lattice, el, surface_);
+    tri_triangles_ = surface_.triangles.size();
+    device_bytes_ += tri_triangles_ * (3 * 4 + 3 * 4) + (n_ + 1) * 4 +
+                     3 * tri_triangles_ * scene.indenters.size() * 4 * real_size_;
+  }
+  contact_stiffness_n_m_ = penalty.stiffness_n_m;
   require(double(device_bytes_) < 0.9 * double(cl.info.global_memory_bytes) &&
               std::max((el.hyperelastic ? 3 : 1) * state_bytes, cells * sizeof(cl_int)) <= cl.info.max_allocation_bytes,
           "the model needs " + mib(double(device_bytes_)) + " of device memory but '" + cl.info.name +
@@ -220,7 +236,8 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     if (const char* env = std::getenv("VOXBREAST_VOLUME_LAUNCHES")) {
       const int k = std::atoi(env);
       if (k == 1 || k == 2) volume_launches_ = k;
-      if (k == 0 && scene.solver.integrator == Integrator::Heun) volume_launches_ = 0;
+      // Triangle contact reads the state without a pending projection: it keeps the apply launches.
+      if (k == 0 && scene.solver.integrator == Integrator::Heun && !tri_contact_) volume_launches_ = 0;
     }
     const bool wide = cl.info.is_gpu &&
                       cl.info.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>() >= kVolumeGpuWorkGroup &&
@@ -256,9 +273,10 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_TORUS_BASE=" + std::to_string(torus_table_base());
   options += " -DVB_FRICTION=" + std::to_string(friction);
   options += " -DVB_REST_OFFSET=" + std::to_string(rest_offsets_);
+  options += " -DVB_TRI_CONTACT=" + std::to_string(tri_contact_);
   // device_contact.cl first: the indenters' friction reuses its grip helpers.
-  std::vector<std::string> sources = {"common.cl", "hyperelastic.cl", "device_contact.cl", "lattice_forces.cl",
-                                      "integrate.cl"};
+  std::vector<std::string> sources = {"common.cl",         "hyperelastic.cl",     "device_contact.cl",
+                                      "lattice_forces.cl", "triangle_contact.cl", "integrate.cl"};
   if (volume_) sources.push_back("volume.cl");
   if (relax_) sources.push_back("relax.cl");
   sources.push_back("checks.cl");
@@ -278,7 +296,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     correct_ = cl::Kernel(program_, "heun_correct");
   } else if (relax_) {
     relax_kernel_ = cl::Kernel(program_, "relax_step");
-    relax_scale_ = make_real_buffer(relaxation_mass_scale(lattice, el));
+    relax_scale_ = make_real_buffer(relaxation_mass_scale(lattice, el, penalty.row_n_m));
     relax_kernel_.setArg(kStepIndenter + kIndenterArgs + 2, relax_scale_);
   } else {
     euler_ = cl::Kernel(program_, "euler_step");
@@ -311,6 +329,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   }
   if (volume_) make_volume_buffers(surface_);
   if (!scene.tori.empty()) make_contact_area_buffer();
+  if (tri_contact_) make_triangle_contact_buffers();
   if (rest_offsets_) set_rest_offsets(std::vector<double>(3 * n_, 0.0));  // R₀ = I, J₀ = 1
 }
 
@@ -658,6 +677,8 @@ std::vector<double> Simulator::indenter_row(std::size_t i) const {
   row[15] = ind.length_m;
   row[16] = m.t0_s;
   row[17] = ind.friction;  // Coulomb μ (push contact)
+  row[18] = ind.contact_surface == IndenterSpec::Surface::Triangles ? 1.0 : 0.0;
+  row[19] = contact_stiffness_n_m_.at(i);  // the penalty of triangle contact (N/m)
   return row;
 }
 
@@ -803,17 +824,20 @@ void Simulator::advance(std::int64_t steps) {
         continue;
       }
       enqueue_stress(u_);
+      enqueue_triangle_contact(u_, t0);
       launch(predict_, step_global_, step_local_);
       // The predicted stage is projected too: its velocity along g would otherwise reach the
       // corrector's dashpots and leave a steady slip at the constrained equilibrium.
       if (project) enqueue_volume_correction(u_tmp_, v_tmp_);
       enqueue_stress(u_tmp_);
+      enqueue_triangle_contact(u_tmp_, t1);
       launch(correct_, step_global_, step_local_);
     } else {
       cl::Kernel& k = relax_ ? relax_kernel_ : euler_;
       k.setArg(0, u_); k.setArg(1, v_); k.setArg(2, u_tmp_); k.setArg(3, v_tmp_);
       if (indenter) set_indenter_args(k, kStepIndenter, t0, t1);
       enqueue_stress(u_);
+      enqueue_triangle_contact(u_, t0);
       enqueue(k);
       std::swap(u_, u_tmp_);
       std::swap(v_, v_tmp_);
@@ -830,6 +854,7 @@ StateCheck Simulator::check() {
   set_indenter_args(check_, kCheckIndenter, time_s(), time_s());
   enqueue_stress(u_);
   if (volume_) enqueue_volume_sums(true);  // the pressure the residual leaves out
+  enqueue_triangle_contact(u_, time_s());
   enqueue_check();
   std::vector<double> p(check_groups_ * check_slots_);
   if (precision_ == Precision::Double) {
@@ -971,6 +996,75 @@ std::vector<double> Simulator::lattice_forces() {
   enqueue(k);
   std::vector<double> out;
   if (precision_ == Precision::Double) read_xyz<double>(f, out); else read_xyz<float>(f, out);
+  return out;
+}
+
+}  // namespace vb
+
+namespace vb {
+
+void Simulator::make_triangle_contact_buffers() {
+  const TriangleContactMesh m = triangle_contact_mesh(surface_, n_);
+  const auto flags_ro = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
+  const auto buffer = [&](auto& v) {
+    return cl::Buffer(cl_.context, flags_ro, v.size() * sizeof(v[0]), const_cast<void*>(static_cast<const void*>(v.data())));
+  };
+  tri_elements_ = buffer(m.triangles);
+  tri_start_ = buffer(m.start);
+  tri_corner_ = buffer(m.corner);
+  const std::size_t corners = 3 * tri_triangles_ * std::max<std::size_t>(1, scene_.indenters.size());
+  std::vector<char> zeros(corners * 4 * real_size_, 0);
+  corner_force_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, zeros.size(), zeros.data());
+
+  // kernels/triangle_contact.cl: u, cell_of, sy, sz, origin, h, triangles, count, frame sign,
+  // indenters, t, corner forces
+  tri_kernel_ = cl::Kernel(program_, "triangle_contact");
+  tri_kernel_.setArg(1, cell_);
+  tri_kernel_.setArg(2, cl_int(stride_y_));
+  tri_kernel_.setArg(3, cl_int(stride_z_));
+  set_world_vector(tri_kernel_, 4, lattice_.origin_m);
+  set_real(tri_kernel_, 5, lattice_.spacing_m);
+  tri_kernel_.setArg(6, tri_elements_);
+  tri_kernel_.setArg(7, cl_uint(tri_triangles_));
+  set_real(tri_kernel_, 8, lattice_.rotation.determinant() < 0 ? -1.0 : 1.0);  // outward in the lattice frame
+  tri_kernel_.setArg(9, indenters_);
+  tri_kernel_.setArg(11, corner_force_);
+  // The stepping and check kernels end with VB_TRI_PARAMS: corner forces, CSR start, corners, count.
+  for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_, &check_}) {
+    if (!(*k)()) continue;
+    const int last = int(k->getInfo<CL_KERNEL_NUM_ARGS>());
+    k->setArg(last - 4, corner_force_);
+    k->setArg(last - 3, tri_start_);
+    k->setArg(last - 2, tri_corner_);
+    k->setArg(last - 1, cl_uint(tri_triangles_));
+  }
+}
+
+void Simulator::enqueue_triangle_contact(const cl::Buffer& u, double t_s) {
+  if (!tri_contact_) return;
+  tri_kernel_.setArg(0, u);
+  set_real(tri_kernel_, 10, t_s);
+  const std::size_t wg = kCheckWorkGroup;
+  launch(tri_kernel_, cl::NDRange((tri_triangles_ + wg - 1) / wg * wg), cl_.info.is_gpu ? cl::NDRange(wg) : cl::NullRange);
+}
+
+std::vector<double> Simulator::triangle_contact_forces_n() {
+  require(tri_contact_, "no indenter of the scene uses contact_surface = \"triangles\"", "indenter");
+  enqueue_triangle_contact(u_, time_s());
+  const std::size_t count = 4 * 3 * tri_triangles_ * std::max<std::size_t>(1, scene_.indenters.size());
+  std::vector<double> raw(count);
+  if (precision_ == Precision::Double) {
+    cl_.queue.enqueueReadBuffer(corner_force_, CL_TRUE, 0, count * sizeof(double), raw.data());
+  } else {
+    std::vector<float> f(count);
+    cl_.queue.enqueueReadBuffer(corner_force_, CL_TRUE, 0, count * sizeof(float), f.data());
+    std::copy(f.begin(), f.end(), raw.begin());
+  }
+  std::vector<double> out(3 * (count / 4));
+  for (std::size_t k = 0; k < count / 4; ++k) {
+    const Vec3 w = lattice_.rotation * Vec3(raw[4 * k], raw[4 * k + 1], raw[4 * k + 2]);
+    for (int c = 0; c < 3; ++c) out[3 * k + c] = w[c];
+  }
   return out;
 }
 

@@ -131,9 +131,21 @@ class Simulator {
   /// contact pressures divide by
   const std::vector<double>& contact_area_m2() const { return contact_area_host_; }
   const ClContext& context() const { return cl_; }
+  /// the built program (its kernel names show which features were compiled in)
+  const cl::Program& program() const { return program_; }
   /// kernel launches of the last advance() on a profiling queue (ClContext with profiling on),
   /// by kernel name; waits for the device
   std::map<std::string, KernelProfile> kernel_profile() const;
+  /// Triangle contact (`contact_surface = "triangles"`) is compiled in and its buffers exist.
+  bool triangle_contact() const { return tri_contact_; }
+  /// per indenter its triangle-contact penalty stiffness (N/m; 0 for vertex contact)
+  const std::vector<double>& contact_stiffness_n_m() const { return contact_stiffness_n_m_; }
+  /// triangle contact only: the surface mesh it acts on
+  const SurfaceMesh& contact_surface_mesh() const { return surface_; }
+  /// Triangle contact only: the forces on the tissue at the current state, per indenter, triangle
+  /// and corner (3 reals each, N, world frame; zero where it does not touch), as
+  /// kernels/triangle_contact.cl computes them; for tests.
+  std::vector<double> triangle_contact_forces_n();
   /// kernel launches per projection of the volume constraint: 1 (volume_project) or 2
   /// (volume_partials, volume_apply; VOXBREAST_VOLUME_LAUNCHES=2), or 0 (Heun only,
   /// VOXBREAST_VOLUME_LAUNCHES=0): volume_pending computes the projection and the kernels that read
@@ -250,6 +262,16 @@ class Simulator {
       vol_scalars_, vol_done_;
   cl::Kernel vol_partials_, vol_finish_, vol_project_;
   mutable cl::Kernel vol_apply_;
+
+  // Triangle contact (kernels/triangle_contact.cl): the surface mesh (surface_), uploaded once.
+  void make_triangle_contact_buffers();
+  /// per-triangle corner forces for the state u at time t (nothing without triangle contact)
+  void enqueue_triangle_contact(const cl::Buffer& u, double t_s);
+  bool tri_contact_ = false;
+  std::size_t tri_triangles_ = 0;
+  std::vector<double> contact_stiffness_n_m_;
+  cl::Buffer tri_elements_, tri_start_, tri_corner_, corner_force_;
+  cl::Kernel tri_kernel_;
 };
 
 }  // namespace vb

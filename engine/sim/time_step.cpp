@@ -6,19 +6,24 @@
 
 #include "engine/error.hpp"
 #include "engine/sim/host_reference.hpp"
+#include "engine/sim/triangle_contact.hpp"
 
 namespace vb {
 
 namespace {
 
-/// Gershgorin row bounds of M⁻¹K and M⁻¹C (dashpots only) of a free element, over its 3 rows.
-std::pair<double, double> element_rows(const Lattice& lattice, const ElementArrays& el, double dashpot_ratio,
-                                       std::size_t e) {
+/// Gershgorin row bounds of M⁻¹K and M⁻¹C (dashpots only) of a free element, over its 3 rows;
+/// `extra_k` (N/m) is added to every stiffness row (triangle contact's penalty).
+struct Rows {
+  double omega_sq = 0, c_max = 0, k_max = 0;  ///< k_max: the largest stiffness row (N/m)
+};
+Rows element_rows(const Lattice& lattice, const ElementArrays& el, double dashpot_ratio, std::size_t e,
+                  double extra_k = 0) {
   const auto& offsets = neighbour_offsets();
   const auto k = connection_stiffness(lattice, el.stability_modulus_pa, e);
   const auto k_dashpot = connection_stiffness(lattice, el.youngs_modulus_pa, e);  // what the dashpots use
   const auto nb = lattice.neighbours(e);
-  double omega_sq = 0, c_max = 0;
+  Rows r;
   for (int a = 0; a < 3; ++a) {
     double k_row = 0, c_row = 0;
     for (int d = 0; d < 26; ++d) {
@@ -29,36 +34,46 @@ std::pair<double, double> element_rows(const Lattice& lattice, const ElementArra
       k_row += 2 * k[d] * w;
       c_row += 2 * (2 * dashpot_ratio * std::sqrt(k_dashpot[d] * reduced_mass)) * w;
     }
-    omega_sq = std::max(omega_sq, k_row * el.inverse_mass[e]);
-    c_max = std::max(c_max, c_row * el.inverse_mass[e]);
+    r.k_max = std::max(r.k_max, k_row);
+    r.omega_sq = std::max(r.omega_sq, (k_row + extra_k) * el.inverse_mass[e]);
+    r.c_max = std::max(r.c_max, c_row * el.inverse_mass[e]);
   }
-  return {omega_sq, c_max};
+  return r;
 }
 
 }  // namespace
 
 StabilityBounds stability_bounds(const Lattice& lattice, const ElementArrays& el, double dashpot_ratio,
-                                 double global_damping) {
+                                 double global_damping, const std::vector<double>& extra_row_n_m) {
   StabilityBounds b;
   double omega_sq = 0, c_max = 0;
   for (std::size_t e = 0; e < lattice.element_count(); ++e) {
     if (el.inverse_mass[e] == 0) continue;
-    const auto [w2, c] = element_rows(lattice, el, dashpot_ratio, e);
-    omega_sq = std::max(omega_sq, w2);
-    c_max = std::max(c_max, c);
+    const Rows r = element_rows(lattice, el, dashpot_ratio, e, extra_row_n_m.empty() ? 0.0 : extra_row_n_m[e]);
+    omega_sq = std::max(omega_sq, r.omega_sq);
+    c_max = std::max(c_max, r.c_max);
   }
   b.omega_max = std::sqrt(omega_sq);
   b.damping_max = c_max + global_damping;
   return b;
 }
 
-std::vector<double> relaxation_mass_scale(const Lattice& lattice, const ElementArrays& el) {
+std::vector<double> element_row_stiffness_n_m(const Lattice& lattice, const ElementArrays& el) {
+  std::vector<double> k(lattice.element_count(), 0.0);
+  for (std::size_t e = 0; e < lattice.element_count(); ++e)
+    if (el.inverse_mass[e] != 0) k[e] = element_rows(lattice, el, 0, e).k_max;
+  return k;
+}
+
+std::vector<double> relaxation_mass_scale(const Lattice& lattice, const ElementArrays& el,
+                                          const std::vector<double>& extra_row_n_m) {
   std::vector<double> scale(lattice.element_count(), 1.0), omega_sq(lattice.element_count(), 0.0);
-  double highest = 0;
+  double highest = 0;  // of the elastic rows: the penalty makes its elements heavier, not the step shorter
   for (std::size_t e = 0; e < lattice.element_count(); ++e) {
     if (el.inverse_mass[e] == 0) continue;
-    omega_sq[e] = element_rows(lattice, el, 0, e).first;
+    omega_sq[e] = element_rows(lattice, el, 0, e).omega_sq;
     highest = std::max(highest, omega_sq[e]);
+    if (!extra_row_n_m.empty()) omega_sq[e] = element_rows(lattice, el, 0, e, extra_row_n_m[e]).omega_sq;
   }
   for (std::size_t e = 0; e < lattice.element_count(); ++e)
     if (omega_sq[e] > 0) scale[e] = highest / omega_sq[e];
@@ -114,7 +129,12 @@ TimeStepChoice choose_time_step(const Scene& scene, const Lattice& lattice, cons
     choice.bounds = stability_bounds(lattice, el, 0, 0);
     choice.stable_limit_s = stable_time_step(Integrator::SymplecticEuler, choice.bounds, 0);
   } else {
-    choice.bounds = stability_bounds(lattice, el, s.dashpot_ratio, s.damping_per_s);
+    // Triangle contact's penalty adds its stiffness to the surface elements' rows (relaxation
+    // instead scales their masses, relaxation_mass_scale).
+    std::vector<double> penalty;
+    if (uses_triangle_contact(scene))
+      penalty = triangle_contact_penalty(scene, lattice, el, build_surface(lattice)).row_n_m;
+    choice.bounds = stability_bounds(lattice, el, s.dashpot_ratio, s.damping_per_s, penalty);
     choice.stable_limit_s = stable_time_step(s.integrator, choice.bounds, s.damping_per_s);
   }
   if (s.dt_s) {

@@ -12,14 +12,22 @@ struct StabilityBounds {
   double damping_max = 0;  ///< upper bound on the highest modal damping rate c (1/s), incl. global
 };
 
-/// Gershgorin bounds of M⁻¹K and M⁻¹C (+ global damping) over the free elements.
+/// Gershgorin bounds of M⁻¹K and M⁻¹C (+ global damping) over the free elements; `extra_row_n_m`
+/// (per element, N/m, or empty) is stiffness added to each of its rows (triangle contact's penalty).
 StabilityBounds stability_bounds(const Lattice& lattice, const ElementArrays& elements,
-                                 double dashpot_ratio, double global_damping_per_s);
+                                 double dashpot_ratio, double global_damping_per_s,
+                                 const std::vector<double>& extra_row_n_m = {});
+
+/// Per free element the largest Gershgorin row of its elastic stiffness (N/m; 0 for held ones).
+std::vector<double> element_row_stiffness_n_m(const Lattice& lattice, const ElementArrays& elements);
 
 /// Dynamic relaxation's mass scaling (kernels/relax.cl): per element m/m̃ ≥ 1, chosen so that
 /// every free element's Gershgorin bound with its scaled mass m̃ equals the model's ω_max;
-/// 1 for held elements.
-std::vector<double> relaxation_mass_scale(const Lattice& lattice, const ElementArrays& elements);
+/// 1 for held elements. With `extra_row_n_m` (triangle contact's penalty, per element) the bound
+/// includes it while ω_max stays the elastic one: those elements get heavier (m/m̃ < 1) and the
+/// step stays.
+std::vector<double> relaxation_mass_scale(const Lattice& lattice, const ElementArrays& elements,
+                                          const std::vector<double>& extra_row_n_m = {});
 
 /// Largest dt for which the integrator is stable on ẍ = −ω²x − c(ω)ẋ for all ω ≤ ω_max, with
 /// c(ω) = γ + (c_max − γ)(ω/ω_max)² (dashpots are stiffness-proportional, global damping not).
