@@ -13,7 +13,9 @@ case "${1:-}" in
     build=${VOXBREAST_BUILD_DIR:-$root/build}
     rm -rf "$pkgs" && mkdir -p "$pkgs/bin" "$pkgs/lib" "$pkgs/deb"
     cp "$build/apps/voxbreast" "$build/tests/test_physics" "$pkgs/bin/"
-    if [[ -x "$build/tests/test_fit" ]]; then cp "$build/tests/test_fit" "$pkgs/bin/"; fi  # batched fit solves
+    for t in test_fit test_probing; do  # batched fit solves; triangle contact
+      if [[ -x "$build/tests/$t" ]]; then cp "$build/tests/$t" "$pkgs/bin/"; fi
+    done
     # Every shared library the binary needs except the C runtime the device already has.
     ldd "$build/apps/voxbreast" | awk '/=> \// {print $3}' | grep -vE '/(libc|libm|libdl|libpthread|librt|libresolv|ld-linux[^/]*)\.so' |
       while read -r lib; do cp -L "$lib" "$pkgs/lib/"; done
