@@ -78,9 +78,9 @@ std::size_t ForwardModel::batch_size() const {
   }
   // auto: one at a time on every device. Measured (docs/FIT.md, "Batched solves"): a batch runs
   // every copy for as many steps as its slowest (K·max instead of Σ steps: 23% more element-steps
-  // on the 38.7k-element phantom), and it was slower per Jacobian on PoCL (+12%) and on an H200
-  // (0.63 against 0.38 s). It saves only simulator setup, which is 3% of a sequential Jacobian
-  // (summary.json jacobian_timing). Batches stay available as fit.batch = N.
+  // on the 38.7k-element phantom); it was slower per Jacobian on PoCL (+12%) and tied on an H200
+  // (0.35 against 0.34 s: the GPU relaxes the batch 2.6× faster, but building simulators is 70–80%
+  // of a Jacobian there; docs/FIT.md). Batches stay available as fit.batch = N.
   return 1;
 }
 
