@@ -18,13 +18,7 @@ bin=${VOXBREAST_BIN:-build/apps/voxbreast}
 here=$(cd "$(dirname "$0")" && pwd)
 py=$([[ -x /usr/bin/python3 ]] && echo /usr/bin/python3 || echo python3)
 mkdir -p "$out/cases"
-# name type E_pa x y z radius (mm, LPS; the mound is the half-ellipsoid y < 0, radii 70, 40, 65 mm)
-cases="dcis_r6 dcis 16400 10 -20 5 6
-dcis_r10 dcis 16400 -20 -15 -15 10
-idc_r6 idc 20000 -15 -22 12 6
-idc_r10 idc 20000 20 -15 -10 10
-fibroadenoma_r8 fibroadenoma 6400 0 -22 0 8
-fibroadenoma_r12 fibroadenoma 6400 -10 -15 20 12"
+cases=$(grep -v '^#' "$here/../data-samples/phantom/fit_cases.txt")  # name type E_pa x y z radius
 
 scene() {  # file, tumour E, law (linear | neo-hookean), observation, extra [fit] lines, adipose E, gland E
   local law_line=""
