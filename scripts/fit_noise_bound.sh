@@ -22,12 +22,7 @@ E = $2
 E = $3
 [materials.fibroglandular]
 E = $4
-[solver]
-integrator = "relaxation"
-precision = "double"
-check_every = 10
-[gravity]
-posture = "prone"
+$(cat "$here/../data-samples/phantom/fit_solver.toml")
 [fit]
 from_posture = "supine"
 dvf = "$5"

@@ -34,12 +34,7 @@ E = ${6:-3250.0}
 [materials.fibroglandular]
 $law_line
 E = ${7:-6000.0}
-[solver]
-integrator = "relaxation"
-precision = "double"
-check_every = 10
-[gravity]
-posture = "prone"
+$(cat "$here/../data-samples/phantom/fit_solver.toml")
 [fit]
 from_posture = "supine"
 dvf = "$4"

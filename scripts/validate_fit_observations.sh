@@ -38,12 +38,7 @@ E = ${5:-3250.0}
 [materials.fibroglandular]
 $law_line
 E = ${6:-6000.0}
-[solver]
-integrator = "relaxation"
-precision = "double"
-check_every = 10
-[gravity]
-posture = "prone"
+$(cat "$(dirname "$0")/../data-samples/phantom/fit_solver.toml")
 ${7:-}
 [fit]
 tissues = ["adipose", "fibroglandular", "tumour"]

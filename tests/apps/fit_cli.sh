@@ -35,18 +35,27 @@ scene() {  # name, tumour law block, observation file, extra [fit] lines
   cat >"$work/ph/$1.toml" <<TOML
 $(cat "$root/data-samples/phantom/fit_model.toml")
 $2
-[solver]
-integrator = "relaxation"
-precision = "double"
-check_every = 10
-[gravity]
-posture = "prone"
+$(cat "$root/data-samples/phantom/fit_solver.toml")
 [fit]
 from_posture = "supine"
 dvf = "$3"
 tissues = ["adipose", "fibroglandular", "tumour"]
 $4
 TOML
+}
+# The label-map and surface fits start from wrong moduli (their scene's material table): 1.8, 11
+# and 6 kPa against the truth's 3.25, 6 and 16.4.
+wrong='[materials.adipose]
+E = 1800.0
+[materials.fibroglandular]
+E = 11000.0
+[materials.tumour]
+E = 6000.0'
+label_scene() {  # the deformed truth's label map and the scene ph/lab.toml that observes it
+  "$bin" fit "$work/ph/truth.toml" --make-observed-labels "$work/ph/obs_labels.nii.gz" --labels-subdivide 6 >/dev/null \
+    || fail "--make-observed-labels"
+  scene lab "$wrong" truth.nii.gz 'initial = "materials"'
+  sed -i 's/^dvf = .*/observed_labels = "obs_labels.nii.gz"/' "$work/ph/lab.toml"
 }
 linear='[materials.tumour]
 E = 16400.0'
@@ -150,17 +159,7 @@ mpi)
   [[ $(cut -d, -f1,3 "$work/mpi/timing.csv" | grep -c '^000[13],0$') -eq 2 ]] && pass "cases 1 and 3 on rank 0, case 2 on rank 1" || fail "partition"
   ;;
 labels)
-  "$bin" fit "$work/ph/truth.toml" --make-observed-labels "$work/ph/obs_labels.nii.gz" --labels-subdivide 6 >/dev/null \
-    || fail "--make-observed-labels"
-  # the fit starts from wrong moduli (its scene's material table): 1.8, 11 and 6 kPa
-  wrong='[materials.adipose]
-E = 1800.0
-[materials.fibroglandular]
-E = 11000.0
-[materials.tumour]
-E = 6000.0'
-  scene lab "$wrong" truth.nii.gz 'initial = "materials"'
-  sed -i 's/^dvf = .*/observed_labels = "obs_labels.nii.gz"/' "$work/ph/lab.toml"
+  label_scene
   "$bin" fit "$work/ph/lab.toml" --out "$work/lab" --truth "$work/ph/truth.nii.gz" --no-plots -q >"$work/lab.txt" 2>&1 \
     || { fail "label-map fit"; cat "$work/lab.txt"; }
   sed 's/^initial = .*/&\nmax_iterations = 0/' "$work/ph/lab.toml" >"$work/ph/lab0.toml"
@@ -188,20 +187,11 @@ surface)
   "$bin" fit "$work/ph/truth.toml" --make-observed-surface "$work/ph/body.stl" >/dev/null || fail "--make-observed-surface"
   "$bin" fit "$work/ph/truth.toml" --make-observed-surface "$work/ph/tumour.stl" --surface-label 6 >/dev/null \
     || fail "--make-observed-surface --surface-label 6"
-  "$bin" fit "$work/ph/truth.toml" --make-observed-labels "$work/ph/obs_labels.nii.gz" --labels-subdivide 6 >/dev/null \
-    || fail "--make-observed-labels"
-  wrong='[materials.adipose]
-E = 1800.0
-[materials.fibroglandular]
-E = 11000.0
-[materials.tumour]
-E = 6000.0'
   scene surf "$wrong" truth.nii.gz 'initial = "materials"'
   sed -i 's/^dvf = .*/observed_surface = ["body.stl", "tumour.stl"]\nobserved_surface_values = [0, 6]/' "$work/ph/surf.toml"
   "$bin" fit "$work/ph/surf.toml" --out "$work/surf" --truth "$work/ph/truth.nii.gz" --no-plots -q >"$work/surf.txt" 2>&1 \
     || { fail "surface-mesh fit"; cat "$work/surf.txt"; }
-  scene lab "$wrong" truth.nii.gz 'initial = "materials"'
-  sed -i 's/^dvf = .*/observed_labels = "obs_labels.nii.gz"/' "$work/ph/lab.toml"
+  label_scene
   "$bin" fit "$work/ph/lab.toml" --out "$work/lab" --truth "$work/ph/truth.nii.gz" --no-plots -q >/dev/null 2>&1 || fail "label-map fit"
   for d in surf lab; do
     s="$work/$d/summary.json"
