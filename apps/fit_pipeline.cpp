@@ -421,15 +421,32 @@ json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, 
   return summary;
 }
 
-double write_synthetic_labels(const Scene& scene, const ClContext& cl, const std::string& path, int subdivide) {
+namespace {
+
+/// The truth of a synthetic observation: the scene's posture change with each tissue at its own
+/// material's modulus (m, 3 per element).
+std::vector<double> true_change_m(const Scene& scene, const ClContext& cl, const Lattice& lattice) {
   FitSpec fit = parse_fit_section(scene.source_text, scene.source_path);
   fit.regions = FitSpec::Regions::Labels;
   fit.tissues.clear();
+  const FitRegions regions = make_fit_regions(fit, scene, lattice);
+  const ForwardModel forward(scene, lattice, regions, fit, cl);
+  return forward.solve(moduli_from_materials(scene, lattice, regions)).change_m();
+}
+
+double largest_displacement_m(const std::vector<double>& change) {
+  double largest = 0;
+  for (std::size_t k = 0; k + 2 < change.size(); k += 3)
+    largest = std::max(largest, std::hypot(change[k], change[k + 1], change[k + 2]));
+  return largest;
+}
+
+}  // namespace
+
+double write_synthetic_labels(const Scene& scene, const ClContext& cl, const std::string& path, int subdivide) {
   const PreparedModel model = prepare_model(scene);
-  const FitRegions regions = make_fit_regions(fit, scene, model.lattice);
-  const ForwardModel forward(scene, model.lattice, regions, fit, cl);
-  const std::vector<double> change = forward.solve(moduli_from_materials(scene, model.lattice, regions)).change_m();
   const Lattice& lattice = model.lattice;
+  const std::vector<double> change = true_change_m(scene, cl, lattice);
   std::vector<int> value_of_tissue(lattice.tissue_names.size());
   for (std::size_t t = 0; t < value_of_tissue.size(); ++t) {
     value_of_tissue[t] = int(t) + 1;  // shape models: the model_labels numbering
@@ -442,51 +459,33 @@ double write_synthetic_labels(const Scene& scene, const ClContext& cl, const std
   const ImageVolume labels = deformed_label_map(lattice, change, value_of_tissue, subdivide);
   const int largest_value = *std::max_element(value_of_tissue.begin(), value_of_tissue.end());
   write_nifti(path, labels, largest_value < 256 ? NiftiType::UInt8 : NiftiType::Int16);
-  double largest = 0;
-  for (std::size_t e = 0; e < lattice.element_count(); ++e)
-    largest = std::max(largest, std::hypot(change[3 * e], change[3 * e + 1], change[3 * e + 2]));
-  return largest;
+  return largest_displacement_m(change);
 }
 
 double write_synthetic_surface(const Scene& scene, const ClContext& cl, const std::string& path, int label_value) {
-  FitSpec fit = parse_fit_section(scene.source_text, scene.source_path);
-  fit.regions = FitSpec::Regions::Labels;
-  fit.tissues.clear();
   const PreparedModel model = prepare_model(scene);
   const std::vector<SurfaceRegion> region = surface_regions(scene, model.lattice, {label_value}, "--surface-label");
-  const FitRegions regions = make_fit_regions(fit, scene, model.lattice);
-  const ForwardModel forward(scene, model.lattice, regions, fit, cl);
-  const std::vector<double> change = forward.solve(moduli_from_materials(scene, model.lattice, regions)).change_m();
+  const std::vector<double> change = true_change_m(scene, cl, model.lattice);
   write_triangle_mesh_stl(path, deformed_boundary_mesh(model.lattice, change, region[0].tissue));
-  double largest = 0;
-  for (std::size_t e = 0; e < model.lattice.element_count(); ++e)
-    largest = std::max(largest, std::hypot(change[3 * e], change[3 * e + 1], change[3 * e + 2]));
-  return largest;
+  return largest_displacement_m(change);
 }
 
 double write_synthetic_observation(const Scene& scene, const ClContext& cl, const std::string& path, double noise_m,
                                    std::uint64_t seed) {
-  FitSpec fit = parse_fit_section(scene.source_text, scene.source_path);
-  fit.regions = FitSpec::Regions::Labels;  // each tissue at its own material's modulus: the truth
-  fit.tissues.clear();
   const PreparedModel model = prepare_model(scene);
-  const FitRegions regions = make_fit_regions(fit, scene, model.lattice);
-  const ForwardModel forward(scene, model.lattice, regions, fit, cl);
-  const std::vector<double> change = forward.solve(moduli_from_materials(scene, model.lattice, regions)).change_m();
+  const Lattice& lattice = model.lattice;
+  const std::vector<double> change = true_change_m(scene, cl, lattice);
   std::mt19937_64 random(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
-  const Lattice& lattice = model.lattice;
   std::vector<float> field(3 * std::size_t(lattice.dims[0]) * lattice.dims[1] * lattice.dims[2], 0.0f);
-  double largest = 0;
   for (std::size_t e = 0; e < lattice.element_count(); ++e) {
-    largest = std::max(largest, std::hypot(change[3 * e], change[3 * e + 1], change[3 * e + 2]));
     const bool held = model.elements.inverse_mass[e] == 0;
     for (int a = 0; a < 3; ++a)
       field[3 * std::size_t(lattice.voxel_of_element[e]) + a] =
           float(change[3 * e + a] + (noise_m > 0 && !held ? noise_m * normal(random) : 0.0));
   }
   write_nifti_displacement(path, lattice_grid(lattice), field);
-  return largest;
+  return largest_displacement_m(change);
 }
 
 }  // namespace vb::app
