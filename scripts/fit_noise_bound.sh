@@ -22,7 +22,7 @@ E = $2
 E = $3
 [materials.fibroglandular]
 E = $4
-$(cat "$here/../data-samples/phantom/fit_solver.toml")
+$(cat "$here/../data-samples/phantom/fit_solver.inc")
 [fit]
 from_posture = "supine"
 dvf = "$5"

@@ -34,7 +34,7 @@ E = ${6:-3250.0}
 [materials.fibroglandular]
 $law_line
 E = ${7:-6000.0}
-$(cat "$here/../data-samples/phantom/fit_solver.toml")
+$(cat "$here/../data-samples/phantom/fit_solver.inc")
 [fit]
 from_posture = "supine"
 dvf = "$4"

@@ -38,7 +38,7 @@ E = ${5:-3250.0}
 [materials.fibroglandular]
 $law_line
 E = ${6:-6000.0}
-$(cat "$(dirname "$0")/../data-samples/phantom/fit_solver.toml")
+$(cat "$(dirname "$0")/../data-samples/phantom/fit_solver.inc")
 ${7:-}
 [fit]
 tissues = ["adipose", "fibroglandular", "tumour"]

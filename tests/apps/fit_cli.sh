@@ -35,7 +35,7 @@ scene() {  # name, tumour law block, observation file, extra [fit] lines
   cat >"$work/ph/$1.toml" <<TOML
 $(cat "$root/data-samples/phantom/fit_model.toml")
 $2
-$(cat "$root/data-samples/phantom/fit_solver.toml")
+$(cat "$root/data-samples/phantom/fit_solver.inc")
 [fit]
 from_posture = "supine"
 dvf = "$3"
