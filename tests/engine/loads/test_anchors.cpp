@@ -58,7 +58,8 @@ TEST_P(SphereAnchorPose, MovesAnchoredElementsByExactlyThatRotation) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Poses, SphereAnchorPose,
-                         ::testing::Values(Vec3(0, 0, 5), Vec3(0, 0, -12), Vec3(3, -4, 7)));
+                         ::testing::Values(Vec3(0, 0, 5), Vec3(0, 0, -12), Vec3(3, -4, 7)),
+                         [](const auto& info) { return "pose" + std::to_string(info.index); });
 
 TEST(Anchors, RpyIsYawPitchRollAboutFixedAxes) {
   const Eigen::Matrix3d yaw = rotation_from_rpy_deg(Vec3(0, 0, 90));

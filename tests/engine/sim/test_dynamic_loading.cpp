@@ -41,7 +41,8 @@ TEST_P(Tension, NominalStressMatchesClosedFormAt30Percent) {
   EXPECT_NEAR(nominal / exact, 1.0, 0.03) << law << ": " << nominal << " vs " << exact << " Pa";
 }
 
-INSTANTIATE_TEST_SUITE_P(Laws, Tension, ::testing::Values("neo_hookean", "ogden"));
+INSTANTIATE_TEST_SUITE_P(Laws, Tension, ::testing::Values("neo_hookean", "ogden"),
+                         [](const auto& info) { return std::string(info.param); });
 
 class SimpleShear : public ::testing::TestWithParam<const char*> {};
 
@@ -80,7 +81,8 @@ TEST_P(SimpleShear, ShearStressMatchesClosedFormAt30Percent) {
   EXPECT_NEAR(sigma / exact, 1.0, 0.03) << law << ": " << sigma << " vs " << exact << " Pa";
 }
 
-INSTANTIATE_TEST_SUITE_P(Laws, SimpleShear, ::testing::Values("neo_hookean", "ogden"));
+INSTANTIATE_TEST_SUITE_P(Laws, SimpleShear, ::testing::Values("neo_hookean", "ogden"),
+                         [](const auto& info) { return std::string(info.param); });
 
 }  // namespace
 }  // namespace vb

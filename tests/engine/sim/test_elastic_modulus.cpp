@@ -56,7 +56,11 @@ TEST_P(EffectiveModulus, StretchReproducesYoungsModulus) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Blocks, EffectiveModulus,
-                         ::testing::Values(BlockSize{12, 12, 6}, BlockSize{16, 20, 8}, BlockSize{24, 24, 4}));
+                         ::testing::Values(BlockSize{12, 12, 6}, BlockSize{16, 20, 8}, BlockSize{24, 24, 4}),
+                         [](const auto& info) {  // e.g. 12x12x6
+                           const BlockSize& b = info.param;
+                           return std::to_string(b.nx) + "x" + std::to_string(b.ny) + "x" + std::to_string(b.nz);
+                         });
 
 }  // namespace
 }  // namespace vb

@@ -2,6 +2,7 @@
 // (rigid motion, total force and torque), homogeneous states against closed forms, and
 // hourglass control.
 #include <array>
+#include <cmath>
 #include <cstdlib>
 #include <gtest/gtest.h>
 
@@ -182,7 +183,11 @@ INSTANTIATE_TEST_SUITE_P(Stretches, HomogeneousUniaxial,
                          ::testing::Values(Uniaxial{"neo_hookean", 0.5}, Uniaxial{"neo_hookean", 0.7},
                                            Uniaxial{"neo_hookean", 0.9}, Uniaxial{"neo_hookean", 1.3},
                                            Uniaxial{"ogden", 0.5}, Uniaxial{"ogden", 0.7}, Uniaxial{"ogden", 0.9},
-                                           Uniaxial{"ogden", 1.3}));
+                                           Uniaxial{"ogden", 1.3}),
+                         [](const auto& info) {  // e.g. ogden_stretch_130
+                           return std::string(info.param.law) + "_stretch_" +
+                                  std::to_string(int(std::lround(100 * info.param.stretch)));
+                         });
 
 TEST(HyperelasticKernels, SimpleShearMatchesClosedForm) {
   for (const MaterialSpec& material : {neo_hookean(3000, 0.499), ogden_two_term()}) {

@@ -81,7 +81,8 @@ TEST_P(KernelForces, MatchHostReference) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Precisions, KernelForces,
-                         ::testing::Values(Case{Precision::Double, 1e-12}, Case{Precision::Float, 1e-5}));
+                         ::testing::Values(Case{Precision::Double, 1e-12}, Case{Precision::Float, 1e-5}),
+                         [](const auto& info) { return info.param.precision == Precision::Double ? "Double" : "Float"; });
 
 class KernelSteps : public ::testing::TestWithParam<Integrator> {};
 

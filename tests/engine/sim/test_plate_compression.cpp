@@ -5,6 +5,9 @@
 // volume"), so the cube is (n − 1)·h on a side and its stretch is the plates' gap over (n − 1)·h.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+
 #include "engine/material/hyperelastic.hpp"
 #include "engine/sim/run.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
@@ -51,7 +54,11 @@ TEST_P(PlateCompression, NominalStressMatchesClosedForm) {
 INSTANTIATE_TEST_SUITE_P(Levels, PlateCompression,
                          ::testing::Values(Level{"neo_hookean", 0.9}, Level{"neo_hookean", 0.7},
                                            Level{"neo_hookean", 0.5}, Level{"ogden", 0.9}, Level{"ogden", 0.7},
-                                           Level{"ogden", 0.5}));
+                                           Level{"ogden", 0.5}),
+                         [](const auto& info) {  // e.g. ogden_stretch_70
+                           return std::string(info.param.law) + "_stretch_" +
+                                  std::to_string(int(std::lround(100 * info.param.stretch)));
+                         });
 
 }  // namespace
 }  // namespace vb
