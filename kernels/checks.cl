@@ -13,7 +13,8 @@
 // forces |f_n| (N), 6 peak contact pressure (Pa, max), 7 deepest penetration of a free element
 // into the tube (m, max).
 // With VB_TRI_CONTACT a triangle-contact indenter's slots hold minus the forces it exerts through
-// the surface triangles (kernels/triangle_contact.cl) and its count of elements that carry some.
+// the surface triangles (kernels/triangle_contact.cl), with friction plus the tangential force
+// its friction holds, and its count of elements that carry some.
 // With VB_RELAX (dynamic relaxation, kernels/relax.cl) four more sums follow: Rayleigh quotients,
 // each ≥ the lowest mode's ω², that the host sets the damping from (Underwood). One is of the
 // displacement u from rest (the lattice force is zero there), one of the change Δu since the previous
@@ -117,9 +118,16 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
         if (!uses_triangles(indenters + VB_IND_STRIDE * i)) continue;
         const real4 pushed = triangle_contact_force(e, i, corner_force, tri_start, tri_corner, n_tri);
         f += pushed;
-        value[5 + 4 * i] = -pushed.x;
-        value[6 + 4 * i] = -pushed.y;
-        value[7 + 4 * i] = -pushed.z;
+        real4 reaction = -pushed;
+#if VB_FRICTION
+        // Friction carries the tangential part of the rest of the element's force (to the normal
+        // pushed/|pushed|) up to μ·|pushed|; the indenter feels it too.
+        const real fn = length(pushed), mu = indenters[VB_IND_STRIDE * i + 17];
+        if (fn > 0 && mu > 0) reaction += friction_hold(&f, pushed / fn, fn, mu);
+#endif
+        value[5 + 4 * i] = reaction.x;
+        value[6 + 4 * i] = reaction.y;
+        value[7 + 4 * i] = reaction.z;
         value[8 + 4 * i] = dot3(pushed, pushed) > 0 ? 1 : 0;
       }
 #endif
