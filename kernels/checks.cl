@@ -71,6 +71,9 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
 #if VB_RELAX
                  , global const real* relax_scale, global real4* relax_prev
 #endif
+#if VB_FRICTION
+                 , real friction_dt  // the steps' dt (s): sets the slip speed an indenter's friction tells
+#endif
                  VB_TRI_PARAMS) {
   local real s[VB_CHECK_SLOTS][VB_CHECK_WG];
   local int s_arg[VB_CHECK_WG];
@@ -87,6 +90,16 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
     value[4] = finite ? 0 : 1;
     if (finite && ui.w != 0) {
       real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
+#if VB_FRICTION
+      // An element in contact slides if its tangential speed relative to the indenter is above a
+      // hundredth of what one step's friction removes (μ·fn·dt/m, per unit μ·fn here; the grip
+      // leaves zero, to rounding, on an element it stopped).
+#if VB_RELAX
+      const real slip_per_n = (real)0.01 * ui.w * relax_scale[e] * friction_dt;
+#else
+      const real slip_per_n = (real)0.01 * ui.w * friction_dt;
+#endif
+#endif
 #if VB_RELAX
       const int R = VB_RELAX_SLOT0;
 #if VB_GRAVITY
@@ -122,8 +135,10 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
 #if VB_FRICTION
         // Friction carries the tangential part of the rest of the element's force (to the normal
         // pushed/|pushed|) up to μ·|pushed|; the indenter feels it too.
-        const real fn = length(pushed), mu = indenters[VB_IND_STRIDE * i + 17];
-        if (fn > 0 && mu > 0) reaction += friction_hold(&f, pushed / fn, fn, mu);
+        global const real* ind = indenters + VB_IND_STRIDE * i;
+        const real fn = length(pushed), mu = ind[17];
+        if (fn > 0 && mu > 0)
+          reaction += friction_carried(&f, pushed / fn, fn, mu, vi - indenter_velocity(ind, t_force), slip_per_n * mu * fn);
 #endif
         value[5 + 4 * i] = reaction.x;
         value[6 + 4 * i] = reaction.y;
@@ -140,8 +155,10 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
         torus_grip grip = {0};
         real4 reaction = contact_constrain(&f, x, indenters + VB_IND_STRIDE * i, t_force, h, &grip);
 #if VB_FRICTION
-        // Friction carries the tangential force up to μ·|f_n| (grip_n = μ·|f_n|).
-        if (grip.grip_n > 0) reaction += friction_hold(&f, grip.normal, length(xyz0(reaction)), indenters[VB_IND_STRIDE * i + 17]);
+        // Friction: kinetic μ·|f_n| for a sliding element, up to μ·|f_n| for one at rest (grip_n = μ·|f_n|).
+        if (grip.grip_n > 0)
+          reaction += friction_carried(&f, grip.normal, length(xyz0(reaction)), indenters[VB_IND_STRIDE * i + 17],
+                                       vi - grip.surface_v, slip_per_n * grip.grip_n);
 #endif
         value[5 + 4 * i] = reaction.x;
         value[6 + 4 * i] = reaction.y;

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <string>
 
 #include "engine/error.hpp"
 #include "engine/sim/run.hpp"
@@ -172,6 +174,113 @@ TEST(Probing, SmallDragOnTrianglesSticks) {
   EXPECT_NEAR(stick, 1.0, 0.1) << "the elements under the ball move with it";
   EXPECT_LT(std::abs(slip), 0.2) << "frictionless: the ball slides over them";
   EXPECT_NEAR(held.force_x_mid, held.force.x(), 0.02 * std::abs(held.force.x())) << "held, not creeping";
+}
+
+// ---- Why the vertex-mode ratio falls short of μ (VOXBREAST_LONG_TESTS=1; docs/VALIDATION.md) ----
+// The sliding ball at other steps, speeds and integrators; at the end, per contact element: its
+// normal force f_n (the inward part of its lattice force), |f_t|/(μ·f_n) of the tangential rest
+// (what the check's friction_hold compares), its tangential speed relative to the ball and the
+// most that one step's friction can remove, μ·f_n·dt/m.
+void friction_study(Surface surface, double speed, double safety, Integrator integrator, bool per_element) {
+  const double mu = 0.3;
+  Scene s = sliding_ball(mu, -1, surface);
+  s.solver.integrator = integrator;
+  s.solver.dt_safety = safety;
+  const Vec3 pressed = s.indenters[0].path[1].position_m;
+  // 6 mm of slide at `speed`, read at the end
+  s.indenters[0].path[2] = {0.05 + 0.008 / speed, pressed + Vec3(0.008, 0, 0)};
+  s.stop.max_time_s = 0.05 + 0.006 / speed;
+  const auto m = test::make_model(s);
+  Simulator sim(s, m.lattice, m.elements, test::cl_context());
+  const RunOutput out = run_simulation(s, m.lattice, m.elements, sim);
+  const Vec3 F = out.summary.indenters[0].reaction_force_n;
+  // mean over the last quarter of the slide's checks (the check-to-check jitter)
+  double fx = 0, fz = 0;
+  int k = 0;
+  for (const auto& h : out.summary.indenters[0].history)
+    if (h[0] >= 0.05 + 0.0045 / speed) fx += h[1], fz += h[3], ++k;
+  std::vector<double> u, v;
+  sim.download(u, v);
+  const std::vector<double> f = sim.lattice_forces();
+  const Vec3 c = sim.indenter_position(0, sim.time_s()), w(speed, 0, 0);
+  double sum_fn = 0, sum_held = 0;
+  int sticking = 0, contacts = 0;
+  Vec3 kinetic = Vec3::Zero(), base = Vec3::Zero();  // on the ball with μ·f_n against each slip; of the base
+  const auto& pos = out.state.position_m;
+  const double mass = 1000 * kH * kH * kH;
+  for (std::size_t e = 0; e < pos.size() / 3; ++e) {
+    const Vec3 x(pos[3 * e], pos[3 * e + 1], pos[3 * e + 2]);
+    const Vec3 fe(f[3 * e], f[3 * e + 1], f[3 * e + 2]), ve(v[3 * e], v[3 * e + 1], v[3 * e + 2]);
+    // the free elements' lattice forces sum to the force of the held base on them (N)
+    if (x.z() - out.state.displacement_m[3 * e + 2] > kH) base += fe;
+    const Vec3 n = (x - c).normalized();
+    const double fn = -fe.dot(n);
+    if ((x - c).norm() > kR + 0.05 * kH || fn <= 0) continue;
+    const Vec3 ft = fe + fn * n, rel = (ve - w) - (ve - w).dot(n) * n;
+    const double stop = mu * fn / mass * sim.dt_s();
+    ++contacts;
+    sum_fn += fn;
+    sum_held += std::min(ft.norm(), mu * fn);
+    if (rel.norm() < 1e-3 * speed) ++sticking;
+    kinetic += -fn * n + (rel.norm() < 1e-3 * speed ? -ft : Vec3(mu * fn * rel.normalized()));
+    if (per_element && surface == Surface::Vertices)
+      std::printf("  element at (%+.1f, %+.1f) mm from the axis: f_n %.3f mN, |f_t|/(mu f_n) %.3f, f_t.x/|f_t| %+.3f, "
+                  "slip speed %.2f mm/s, one step's friction %.2f mm/s\n",
+                  1e3 * (x.x() - c.x()), 1e3 * (x.y() - c.y()), 1e3 * fn, ft.norm() / (mu * fn),
+                  ft.norm() > 0 ? ft.x() / ft.norm() : 0.0, 1e3 * rel.norm(), 1e3 * stop);
+  }
+  std::printf("study %s %s speed %.0f mm/s safety %.3f dt %.4g ms: ratio %.4f (mean of %d checks %.4f), "
+              "contacts %d sticking %d, per-element sum(min(|f_t|, mu f_n))/sum(f_n)/mu %.4f; kinetic ratio %.4f; "
+              "−(base force on the tissue)_x / F_z %.4f\n",
+              surface == Surface::Triangles ? "triangles" : "vertices",
+              integrator == Integrator::Heun ? "heun" : "symplectic", 1e3 * speed, safety, 1e3 * sim.dt_s(),
+              -F.x() / F.z(), k, -fx / fz, contacts, sticking, sum_fn > 0 ? sum_held / sum_fn / mu : 0.0,
+              -kinetic.x() / kinetic.z(), -base.x() / F.z());
+}
+
+// Dynamic relaxation (`voxbreast probe`): a ball pressed on the triangles with friction relaxes
+// like the frictionless press; friction holds the touched surface from spreading under the ball,
+// so the press is a little stiffer, and the forces stay vertical.
+TEST(Probing, FrictionalPressOnTrianglesRelaxes) {
+  const auto press = [](double friction) {
+    Scene s = test::probe_block(12, 12, 8, kH, 3000);
+    IndenterSpec ball;
+    ball.kind = IndenterSpec::Kind::Sphere;
+    ball.radius_m = 3 * kH;
+    ball.contact_surface = Surface::Triangles;
+    ball.contact_stiffness = 0.2;  // as in TriangleContact.SphereOnTrianglesFollowsHertz
+    ball.friction = friction;
+    ball.start_m = Vec3(0, 0, 1.0);
+    s.indenters.push_back(ball);
+    s.stop.equilibrium = 5e-5;
+    s.stop.max_steps = 6000;
+    s.probe = test::press_at(6 * kH, 6 * kH, 0.5 * kH, 2);
+    return test::run_probe(s);
+  };
+  const ProbeResult with = press(0.5), without = press(0);
+  ASSERT_EQ(with.presses.size(), 1u);
+  EXPECT_EQ(with.unconverged_increments, 0);
+  EXPECT_EQ(without.unconverged_increments, 0);
+  const PressSample& a = with.presses[0].samples.back();
+  const PressSample& b = without.presses[0].samples.back();
+  std::printf("press on triangles 1 mm: friction 0.5 %.5g N (%lld steps), frictionless %.5g N (%lld steps), ratio %.4f; "
+              "sideways %.2g N\n",
+              a.press_force_n, (long long)a.steps, b.press_force_n, (long long)b.steps, a.press_force_n / b.press_force_n,
+              std::hypot(a.force_n.x(), a.force_n.y()));
+  EXPECT_GE(a.press_force_n, b.press_force_n);
+  EXPECT_LT(a.press_force_n, 1.15 * b.press_force_n);
+  EXPECT_LT(std::hypot(a.force_n.x(), a.force_n.y()), 0.02 * a.force_n.z());
+}
+
+TEST(Probing, FrictionShortfallStudy) {
+  const char* env = std::getenv("VOXBREAST_LONG_TESTS");
+  if (!env || std::string(env) != "1") GTEST_SKIP() << "set VOXBREAST_LONG_TESTS=1 (a few minutes)";
+  for (Surface surface : {Surface::Vertices, Surface::Triangles}) {
+    friction_study(surface, 0.020, 0.5, Integrator::Heun, true);
+    for (double safety : {0.25, 0.125}) friction_study(surface, 0.020, safety, Integrator::Heun, false);
+    for (double speed : {0.005, 0.010, 0.040}) friction_study(surface, speed, 0.5, Integrator::Heun, false);
+    friction_study(surface, 0.020, 0.5, Integrator::SymplecticEuler, false);
+  }
 }
 
 TEST(Probing, FrictionKey) {
