@@ -14,7 +14,7 @@
 // into the tube (m, max).
 // With VB_TRI_CONTACT a triangle-contact indenter's slots hold minus the forces it exerts through
 // the surface triangles (kernels/triangle_contact.cl), with friction plus the tangential force
-// its friction holds, and its count of elements that carry some.
+// its friction carries, and its count of elements that carry some.
 // With VB_RELAX (dynamic relaxation, kernels/relax.cl) four more sums follow: Rayleigh quotients,
 // each ≥ the lowest mode's ω², that the host sets the damping from (Underwood). One is of the
 // displacement u from rest (the lattice force is zero there), one of the change Δu since the previous
@@ -133,8 +133,8 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
         f += pushed;
         real4 reaction = -pushed;
 #if VB_FRICTION
-        // Friction carries the tangential part of the rest of the element's force (to the normal
-        // pushed/|pushed|) up to μ·|pushed|; the indenter feels it too.
+        // Friction (normal pushed/|pushed|): kinetic μ·|pushed| along a sliding element's slip, the
+        // tangential rest of the force of one at rest up to μ·|pushed|; the indenter feels it too.
         global const real* ind = indenters + VB_IND_STRIDE * i;
         const real fn = length(pushed), mu = ind[17];
         if (fn > 0 && mu > 0)
