@@ -702,8 +702,6 @@ IndenterSpec read_indenter(const Section& s, const std::string& scene_dir) {
              "use kind = \"sphere\", or contact_surface = \"vertices\" for plates, cylinders and capsules");
     if (i.contact != IndenterSpec::Contact::Push)
       s.fail("contact", "triangle contact is unilateral (push)", "remove 'contact' or use contact_surface = \"vertices\"");
-    if (i.friction > 0)
-      s.fail("friction", "triangle contact is frictionless", "remove 'friction' or use contact_surface = \"vertices\"");
   }
   if (const auto path = s.text("path")) {
     for (const char* key : {"start", "velocity", "travel_time"})

@@ -13,7 +13,8 @@
 // forces |f_n| (N), 6 peak contact pressure (Pa, max), 7 deepest penetration of a free element
 // into the tube (m, max).
 // With VB_TRI_CONTACT a triangle-contact indenter's slots hold minus the forces it exerts through
-// the surface triangles (kernels/triangle_contact.cl) and its count of elements that carry some.
+// the surface triangles (kernels/triangle_contact.cl), with friction plus the tangential force
+// its friction carries, and its count of elements that carry some.
 // With VB_RELAX (dynamic relaxation, kernels/relax.cl) four more sums follow: Rayleigh quotients,
 // each ≥ the lowest mode's ω², that the host sets the damping from (Underwood). One is of the
 // displacement u from rest (the lattice force is zero there), one of the change Δu since the previous
@@ -70,6 +71,9 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
 #if VB_RELAX
                  , global const real* relax_scale, global real4* relax_prev
 #endif
+#if VB_FRICTION
+                 , real friction_dt  // the steps' dt (s): sets the slip speed an indenter's friction tells
+#endif
                  VB_TRI_PARAMS) {
   local real s[VB_CHECK_SLOTS][VB_CHECK_WG];
   local int s_arg[VB_CHECK_WG];
@@ -86,6 +90,16 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
     value[4] = finite ? 0 : 1;
     if (finite && ui.w != 0) {
       real4 f = static_force(e, ui, vi, u, v, VB_LATTICE_ARGS);
+#if VB_FRICTION
+      // An element in contact slides if its tangential speed relative to the indenter is above a
+      // hundredth of what one step's friction removes (μ·fn·dt/m, per unit μ·fn here; the grip
+      // leaves zero, to rounding, on an element it stopped).
+#if VB_RELAX
+      const real slip_per_n = (real)0.01 * ui.w * relax_scale[e] * friction_dt;
+#else
+      const real slip_per_n = (real)0.01 * ui.w * friction_dt;
+#endif
+#endif
 #if VB_RELAX
       const int R = VB_RELAX_SLOT0;
 #if VB_GRAVITY
@@ -117,9 +131,18 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
         if (!uses_triangles(indenters + VB_IND_STRIDE * i)) continue;
         const real4 pushed = triangle_contact_force(e, i, corner_force, tri_start, tri_corner, n_tri);
         f += pushed;
-        value[5 + 4 * i] = -pushed.x;
-        value[6 + 4 * i] = -pushed.y;
-        value[7 + 4 * i] = -pushed.z;
+        real4 reaction = -pushed;
+#if VB_FRICTION
+        // Friction (normal pushed/|pushed|): kinetic μ·|pushed| along a sliding element's slip, the
+        // tangential rest of the force of one at rest up to μ·|pushed|; the indenter feels it too.
+        global const real* ind = indenters + VB_IND_STRIDE * i;
+        const real fn = length(pushed), mu = ind[17];
+        if (fn > 0 && mu > 0)
+          reaction += friction_carried(&f, pushed / fn, fn, mu, vi - indenter_velocity(ind, t_force), slip_per_n * mu * fn);
+#endif
+        value[5 + 4 * i] = reaction.x;
+        value[6 + 4 * i] = reaction.y;
+        value[7 + 4 * i] = reaction.z;
         value[8 + 4 * i] = dot3(pushed, pushed) > 0 ? 1 : 0;
       }
 #endif
@@ -132,8 +155,10 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
         torus_grip grip = {0};
         real4 reaction = contact_constrain(&f, x, indenters + VB_IND_STRIDE * i, t_force, h, &grip);
 #if VB_FRICTION
-        // Friction carries the tangential force up to μ·|f_n| (grip_n = μ·|f_n|).
-        if (grip.grip_n > 0) reaction += friction_hold(&f, grip.normal, length(xyz0(reaction)), indenters[VB_IND_STRIDE * i + 17]);
+        // Friction: kinetic μ·|f_n| for a sliding element, up to μ·|f_n| for one at rest (grip_n = μ·|f_n|).
+        if (grip.grip_n > 0)
+          reaction += friction_carried(&f, grip.normal, length(xyz0(reaction)), indenters[VB_IND_STRIDE * i + 17],
+                                       vi - grip.surface_v, slip_per_n * grip.grip_n);
 #endif
         value[5 + 4 * i] = reaction.x;
         value[6 + 4 * i] = reaction.y;

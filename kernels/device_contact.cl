@@ -47,6 +47,22 @@ VB_INLINE real4 friction_hold(real4* f, real4 n, real fn, real mu) {
   return held;
 }
 
+// At a check, for an indenter: the friction force a contact carries (removed from f, returned:
+// the force on the indenter). An element that slides over the surface (tangential speed relative
+// to it above `slip`, m/s) carries the kinetic friction μ·fn along its slip: what the steps'
+// grip applies to it, whatever its own tangential force is at this instant (a sliding element's
+// spring force swings about μ·fn as it slides; capping it at μ·fn, as for one at rest, reads the
+// swings short: docs/VALIDATION.md, issue 9 "Friction"). One at rest on the surface (the grip
+// stopped it) carries its tangential force up to μ·fn (friction_hold).
+VB_INLINE real4 friction_carried(real4* f, real4 n, real fn, real mu, real4 v_rel, real slip) {
+  const real4 vt = xyz0(v_rel) - dot3(v_rel, n) * n;
+  const real speed = length(vt);
+  if (!(speed > slip)) return friction_hold(f, n, fn, mu);
+  const real4 held = (mu * fn / speed) * vt;
+  *f -= held;
+  return held;
+}
+
 #if VB_TORI
 VB_INLINE global const real* torus_row(global const real* table, int i) {
   return table + VB_TORUS_BASE + VB_TORUS_STRIDE * i;

@@ -11,14 +11,14 @@
 // indenters' constraint added as static_force and acceleration add them.
 // `grip` collects the indenters' friction (device_contact.cl), turned into m/s² like the torus's.
 // With VB_TRI_CONTACT the triangle-contact forces (triangle_contact.cl, computed for the same u
-// just before this kernel) are added; VB_TRI_PARAMS is empty otherwise.
+// just before this kernel) are added, and with friction their grip; VB_TRI_PARAMS is empty otherwise.
 inline real4 acceleration_from(real4 f, uint e, real4 ui, real4 vi, VB_LATTICE_PARAMS,
                                global const real* indenters, real t, torus_grip* grip VB_TRI_PARAMS) {
 #if VB_GRAVITY
   f += xyz0(gravity) / ui.w;
 #endif
 #if VB_TRI_CONTACT
-  f += triangle_contact_all(e, indenters, corner_force, tri_start, tri_corner, n_tri);  // computed for this u
+  f += triangle_contact_all(e, indenters, t, grip, corner_force, tri_start, tri_corner, n_tri);  // computed for this u
 #endif
 #if VB_GLOBAL_DAMPING
   f -= damping * xyz0(vi) / ui.w;

@@ -5,8 +5,8 @@
 //   triangle_contact: one work-item per triangle writes, per indenter, its three corner forces;
 //   triangle_contact_force: each element sums the corners it is (CSR tri_start / tri_corner).
 //   -DVB_TRI_CONTACT=0|1  some indenter uses it (nothing here is compiled otherwise)
-// Indenter row columns (kernels/common.cl): 18 contact surface (0 vertices, 1 triangles),
-// 19 penalty stiffness k_p (N/m).
+// Indenter row columns (kernels/common.cl): 17 Coulomb μ, 18 contact surface (0 vertices,
+// 1 triangles), 19 penalty stiffness k_p (N/m).
 #if VB_TRI_CONTACT
 #define VB_TRI_PARAMS \
   , global const real4 *corner_force, global const uint *tri_start, global const uint *tri_corner, uint n_tri
@@ -105,13 +105,26 @@ inline real4 triangle_contact_force(uint e, int i, global const real4* corner_fo
   return xyz0(f);
 }
 
-// All triangle-contact indenters' forces on element e (N).
-inline real4 triangle_contact_all(uint e, global const real* indenters, global const real4* corner_force,
-                                  global const uint* tri_start, global const uint* tri_corner, uint n_tri) {
+// All triangle-contact indenters' forces on element e (N) at time t. With friction (VB_FRICTION,
+// column 17 μ > 0) each indenter's gathered force f on the element, its share of the touching
+// triangles' penalty forces (all along their normals), is the element's normal force: it adds
+// μ·|f| to the element's grip with the normal f/|f| and the indenter's velocity
+// (device_contact.cl: Coulomb stick/slip at the velocity level, as for vertex contact). The sum
+// is formed the same way with or without friction (μ = 0: the frictionless result bit for bit).
+inline real4 triangle_contact_all(uint e, global const real* indenters, real t, torus_grip* grip,
+                                  global const real4* corner_force, global const uint* tri_start,
+                                  global const uint* tri_corner, uint n_tri) {
   real4 f = (real4)(0);
-  for (int i = 0; i < VB_INDENTERS; ++i)
-    if (uses_triangles(indenters + VB_IND_STRIDE * i))
-      f += triangle_contact_force(e, i, corner_force, tri_start, tri_corner, n_tri);
+  for (int i = 0; i < VB_INDENTERS; ++i) {
+    global const real* ind = indenters + VB_IND_STRIDE * i;
+    if (!uses_triangles(ind)) continue;
+    const real4 pushed = triangle_contact_force(e, i, corner_force, tri_start, tri_corner, n_tri);
+    f += pushed;
+#if VB_FRICTION
+    const real fn = length(pushed);
+    if (fn > 0) grip_add(grip, -fn, ind[17], pushed / fn, indenter_velocity(ind, t));
+#endif
+  }
   return f;
 }
 #else

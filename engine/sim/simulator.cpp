@@ -327,6 +327,10 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     check_.setArg(relax_arg + 1, relax_prev_);
     set_real(relax_kernel_, kStepIndenter + kIndenterArgs + 3, damping_);
   }
+  if (friction) {  // check_state's friction_dt, just before VB_TRI_PARAMS (kernels/checks.cl)
+    const int last = int(check_.getInfo<CL_KERNEL_NUM_ARGS>());
+    set_real(check_, last - 1 - (tri_contact_ ? 4 : 0), dt_.dt_s);
+  }
   if (volume_) make_volume_buffers(surface_);
   if (!scene.tori.empty()) make_contact_area_buffer();
   if (tri_contact_) make_triangle_contact_buffers();

@@ -23,8 +23,6 @@ void check_triangle_contact(const Scene& scene) {
             "use kind = \"sphere\" (a point probe), or contact_surface = \"vertices\"");
     require(i.contact == IndenterSpec::Contact::Push, "triangle contact is unilateral (push) only", where,
             "use contact = \"push\", or contact_surface = \"vertices\"");
-    require(i.friction == 0, "triangle contact is frictionless", where,
-            "remove 'friction', or use contact_surface = \"vertices\"");
     require(i.contact_stiffness > 0 && std::isfinite(i.contact_stiffness), "contact_stiffness must be positive", where);
   }
 }

@@ -16,7 +16,7 @@ namespace vb {
 bool uses_triangle_contact(const Scene& scene);
 
 /// Throws vb::Error when an indenter asks for triangle contact in a way that is not built: a shape
-/// other than a sphere, slide or stick contact, friction.
+/// other than a sphere, slide or stick contact. (Friction is built: kernels/triangle_contact.cl.)
 void check_triangle_contact(const Scene& scene);
 
 struct TriangleContactPenalty {

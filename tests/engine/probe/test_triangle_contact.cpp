@@ -242,7 +242,9 @@ TEST(TriangleContact, SceneKeys) {
   EXPECT_DOUBLE_EQ(s.indenters[0].contact_stiffness, 2.5);
   EXPECT_THROW(parse_scene_text(sphere + "contact_surface = \"edges\"\n", "s.toml"), Error);
   EXPECT_THROW(parse_scene_text(sphere + "contact_stiffness = 2\n", "s.toml"), Error) << "only with triangles";
-  EXPECT_THROW(parse_scene_text(sphere + "contact_surface = \"triangles\"\nfriction = 0.3\n", "s.toml"), Error);
+  EXPECT_DOUBLE_EQ(parse_scene_text(sphere + "contact_surface = \"triangles\"\nfriction = 0.3\n", "s.toml").indenters[0].friction,
+                   0.3)
+      << "Coulomb friction is built for triangle contact (test_indenter_friction.cpp)";
   EXPECT_THROW(parse_scene_text(sphere + "contact_surface = \"triangles\"\ncontact = \"stick\"\n", "s.toml"), Error);
   EXPECT_THROW(parse_scene_text(head + "kind = \"plate\"\nnormal = [0, 0, -1]\ncontact_surface = \"triangles\"\n", "s.toml"),
                Error);
