@@ -17,6 +17,12 @@ namespace vb {
 namespace {
 
 constexpr double kContactTol = 1e-3;  // of a spacing, as REAL_CONTACT_TOL (kernels/common.cl)
+// A triangle-contact (penalty) probe moves to each increment at most this many spacings per step,
+// as the haptic loop does (0.25 h per 20 steps). Placed a whole increment deep at once, it pushes
+// the surface elements with k_p·increment; their fast contact mode is barely damped (relaxation
+// damps the slowest mode), so they overshoot by about the increment, and 1 mm increments at
+// h = 2 mm folded the layer below and lost the contact (docs/VALIDATION.md, issue 9).
+constexpr double kPenaltyRampPerStep = 0.0125;
 
 struct Relaxed {
   StateCheck check;
@@ -26,8 +32,9 @@ struct Relaxed {
 };
 
 /// Steps until the residual (and, for the dynamic integrators, the speed) meets the scene's
-/// equilibrium tolerance or stop.max_steps have run.
-Relaxed relax(const Scene& scene, const Lattice& lattice, const ElementArrays& el, Simulator& sim) {
+/// equilibrium tolerance or stop.max_steps have run; not before `min_steps` (a probe still moving).
+Relaxed relax(const Scene& scene, const Lattice& lattice, const ElementArrays& el, Simulator& sim,
+              std::int64_t min_steps = 0) {
   const auto [F_ref, wave_speed] = equilibrium_scales(lattice, el);
   const double tol = scene.stop.equilibrium > 0 ? scene.stop.equilibrium : 1e-6;
   const std::int64_t every = std::max(1, scene.solver.check_every);
@@ -42,7 +49,7 @@ Relaxed relax(const Scene& scene, const Lattice& lattice, const ElementArrays& e
                   "solver", "use a smaller solver.dt or smaller probe increments (more [probe] steps)");
     r.residual = r.check.max_residual_n / F_ref;
     const bool at_rest = scene.solver.integrator == Integrator::Relaxation || r.check.max_speed_m_s / wave_speed <= tol;
-    if (r.residual <= tol && at_rest) {
+    if (r.residual <= tol && at_rest && r.steps >= min_steps) {
       r.converged = true;
       break;
     }
@@ -144,8 +151,17 @@ ProbeResult run_press_line(const Scene& scene, const Lattice& lattice, const Ele
     for (int j = 0; j <= p.steps; ++j) {
       PressSample sample;
       sample.depth_m = p.depth_m * j / p.steps;
-      sim.place_indenter(p.indenter, start + sample.depth_m * dir);
-      const Relaxed r = relax(scene, lattice, el, sim);
+      const Vec3 target = start + sample.depth_m * dir;
+      std::int64_t ramp_steps = 0;
+      if (triangles && j > 0) {
+        const Vec3 from = start + (p.depth_m * (j - 1) / p.steps) * dir;
+        ramp_steps = std::int64_t(std::ceil((target - from).norm() / (kPenaltyRampPerStep * h)));
+        const double t0 = sim.time_s();
+        sim.set_indenter_motion(p.indenter, IndenterMotion::straight(from, target, t0, t0 + ramp_steps * sim.dt_s()));
+      } else {
+        sim.place_indenter(p.indenter, target);
+      }
+      const Relaxed r = relax(scene, lattice, el, sim, ramp_steps);
       out.total_steps += r.steps;
       if (!r.converged) ++out.unconverged_increments;
       if (progress) progress(k, j, r.residual);

@@ -274,6 +274,8 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_FRICTION=" + std::to_string(friction);
   options += " -DVB_REST_OFFSET=" + std::to_string(rest_offsets_);
   options += " -DVB_TRI_CONTACT=" + std::to_string(tri_contact_);
+  // the penalty geometry in double where the device has it (kernels/triangle_contact.cl)
+  options += " -DVB_TRI_FP64=" + std::to_string(tri_contact_ && cl_.info.fp64);
   // device_contact.cl first: the indenters' friction reuses its grip helpers.
   std::vector<std::string> sources = {"common.cl",         "hyperelastic.cl",     "device_contact.cl",
                                       "lattice_forces.cl", "triangle_contact.cl", "integrate.cl"};

@@ -172,34 +172,60 @@ TEST(TriangleContact, PointProbeBetweenVerticesFeelsTheSurface) {
   EXPECT_LT(tri_v.reaction_vs_sum, 1e-9);
 }
 
-// The Hertz check of test_hertz_contact.cpp with the ball on the triangles.
-TEST(TriangleContact, SphereOnTrianglesFollowsHertz) {
-  const double h = 0.002, Estar = kE * 16 / 15;
+// The Hertz check of test_hertz_contact.cpp with the ball on the triangles, at the default
+// penalty and the vertex test's float model and 1e-6 equilibrium. The faces between the vertices
+// dip into a sphere through them by up to the sagitta s = h²/(4R) (0.056 mm here), so triangle
+// contact, which keeps the faces out of the ball, presses the vertices deeper than vertex contact:
+// with a rigid penalty it is vertex contact of a ball of radius R + s at the same centre. The
+// penalty's own compliance keeps it below that (docs/VALIDATION.md, issue 9).
+struct HertzPress {
+  std::vector<double> depth_m, force_n;
+  Vec3 last_force_n = Vec3::Zero();
+  int unconverged = 0;
+};
+
+HertzPress hertz_press(double radius, IndenterSpec::Surface surface, double zero_z) {
+  const double h = 0.002;
   const int n = 25, nz = 20;
   Scene s = test::probe_block(n, n, nz, h, kE);
-  const double R = 9 * h, depth = 1.0 * h;
-  IndenterSpec ball = point_probe(R);
-  // A softer penalty and a looser equilibrium than the vertex test: relaxation with the penalty's
-  // heavier surface elements stalls near a residual of 1e-5 (contacts entering and leaving at
-  // |p − c| = r); at 5e-5 the force has settled to 0.1% (docs/VALIDATION.md, issue 9).
-  ball.contact_stiffness = 0.2;
-  s.indenters.push_back(ball);
-  s.stop.equilibrium = 5e-5;
-  s.stop.max_steps = 6000;
-  s.probe = test::press_at(0.5 * n * h, 0.5 * n * h, depth, 2);
+  s.indenters.push_back(point_probe(radius, surface));
+  s.stop.max_steps = 3000;
+  s.probe = test::press_at(0.5 * n * h, 0.5 * n * h, 1.0 * h, 2);  // over an element column, 1 mm increments
+  s.probe.from_contact = false;  // every ball at the same centres
+  s.probe.from_m = s.probe.to_m = Vec3(0.5 * n * h, 0.5 * n * h, zero_z);
   const ProbeResult r = test::run_probe(s);
-  ASSERT_EQ(r.presses.size(), 1u);
-  EXPECT_EQ(r.unconverged_increments, 0);
-  for (const PressSample& p : r.presses[0].samples) {
-    if (p.depth_m == 0) continue;
-    const double hertz = 4.0 / 3 * Estar * std::sqrt(R) * std::pow(p.depth_m, 1.5);
-    std::printf("hertz (triangles) depth %.3f mm  F %.5g N  Hertz %.5g N  ratio %.3f  contact %lld  area %.2f mm2 "
-                "(pi a2 %.2f)  steps %lld residual %.3g\n",
-                1e3 * p.depth_m, p.press_force_n, hertz, p.press_force_n / hertz, (long long)p.contact_elements,
-                1e6 * p.contact_area_m2, 1e6 * M_PI * R * p.depth_m, (long long)p.steps, p.residual);
-    EXPECT_NEAR(p.press_force_n / hertz, 1.0, 0.10) << "at depth " << p.depth_m << " m";
+  HertzPress p;
+  p.unconverged = int(r.unconverged_increments);
+  for (const PressSample& q : r.presses.at(0).samples) {
+    p.depth_m.push_back(q.depth_m), p.force_n.push_back(q.press_force_n), p.last_force_n = q.force_n;
+    std::printf("hertz press  R %.4f mm  %s  depth %.3f mm  F %.5g N  contact %lld  area %.2f mm2  steps %lld residual %.3g\n",
+                1e3 * radius, surface == IndenterSpec::Surface::Triangles ? "triangles" : "vertices", 1e3 * q.depth_m,
+                q.press_force_n, (long long)q.contact_elements, 1e6 * q.contact_area_m2, (long long)q.steps, q.residual);
   }
-  const Vec3 F = r.presses[0].samples.back().force_n;
+  return p;
+}
+
+TEST(TriangleContact, SphereOnTrianglesFollowsHertz) {
+  const double h = 0.002, Estar = kE * 16 / 15, R = 9 * h, s = h * h / (4 * R);
+  const double zero_z = 19.5 * h + R;  // the ball touches the top layer's centres
+  const HertzPress tri = hertz_press(R, IndenterSpec::Surface::Triangles, zero_z);
+  const HertzPress vert = hertz_press(R, IndenterSpec::Surface::Vertices, zero_z);
+  const HertzPress vert_s = hertz_press(R + s, IndenterSpec::Surface::Vertices, zero_z);
+  EXPECT_EQ(tri.unconverged, 0) << "relaxation reaches 1e-6 with the penalty at its default stiffness";
+  for (std::size_t j = 1; j < tri.depth_m.size(); ++j) {
+    const double d = tri.depth_m[j];
+    const double hertz = 4.0 / 3 * Estar * std::sqrt(R) * std::pow(d, 1.5);
+    const double hertz_s = 4.0 / 3 * Estar * std::sqrt(R + s) * std::pow(d + s, 1.5);
+    std::printf("hertz (triangles) depth %.3f mm  F %.5g N  Hertz %.5g N (ratio %.3f)  Hertz of R + s at depth + s "
+                "%.5g N (ratio %.3f)  vertex contact R %.5g N, R + s %.5g N  (share of the sagitta gap %.2f)\n",
+                1e3 * d, tri.force_n[j], hertz, tri.force_n[j] / hertz, hertz_s, tri.force_n[j] / hertz_s,
+                vert.force_n[j], vert_s.force_n[j], (tri.force_n[j] - vert.force_n[j]) / (vert_s.force_n[j] - vert.force_n[j]));
+    EXPECT_NEAR(tri.force_n[j] / hertz_s, 1.0, 0.10) << "at depth " << d << " m";
+    // Stiffer than vertex contact by most of the sagitta's share, softer than its rigid limit.
+    EXPECT_GT(tri.force_n[j], vert.force_n[j] + 0.5 * (vert_s.force_n[j] - vert.force_n[j])) << "at depth " << d;
+    EXPECT_LT(tri.force_n[j], vert_s.force_n[j]) << "at depth " << d;
+  }
+  const Vec3 F = tri.last_force_n;
   EXPECT_LT(std::hypot(F.x(), F.y()), 1e-3 * F.z());
 }
 
