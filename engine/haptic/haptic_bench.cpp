@@ -4,7 +4,7 @@
 
 namespace vb {
 namespace {
-constexpr double kSpacing = 0.002, kProbeRadius = 0.005, kDepth = 0.008;
+constexpr double kSpacing = 0.002, kProbeRadius = 0.005, kDepth = 0.003;  // 3 mm: a 4 mm press folds the lattice (VALIDATION.md)
 }
 
 Scene haptic_bench_scene(std::size_t elements, Precision precision) {
