@@ -101,7 +101,8 @@ nlohmann::json run_haptic_bench(const ClContext& cl, const BenchOptions& o) {
                 lattice.element_count(), r.achieved_rate_hz, 1e3 * r.intervals.mean_s, 1e3 * r.intervals.p99_s,
                 1e3 * r.intervals.max_s, (long long)r.intervals.missed, r.realtime ? ", real-time priority" : "",
                 (long long)r.updates, r.update_rate_hz, row["steps_per_second"].get<double>(),
-                r.blown_up ? "  BLEW UP" : "");
+                r.blown_up ? "  BLEW UP" : r.folded ? "  FOLDED" : "");
+    if (r.folded) std::printf("  warning: %s\n", haptic_fold_warning(r).c_str());
     std::fflush(stdout);
     rows.push_back(row);
   }

@@ -50,6 +50,9 @@ int run_haptic(const HapticCliOptions& o) {
               1e3 * r.intervals.max_s, (long long)r.updates, r.update_rate_hz,
               r.wall_s > 0 ? double(r.steps) / r.wall_s : 0.0);
   std::printf("wrote %s/haptic.csv\nwrote %s/haptic_summary.json\n", o.out.c_str(), o.out.c_str());
+  // A validity warning, not a failure: the run went on and the summary says folded.
+  if (const std::string fold = haptic_fold_warning(r); !fold.empty())
+    std::fprintf(stderr, "voxbreast: warning: %s\n", fold.c_str());
   if (r.blown_up) {
     std::fprintf(stderr, "voxbreast: error: %s\n", r.message.c_str());
     return 1;

@@ -109,23 +109,35 @@ HapticLoopResult run_haptic_loop(HapticProbe& probe, const ProbeTrajectory& traj
       r.message = u.message;
       break;
     }
+    if (u.folded() && r.first_fold_time_s < 0) r.first_fold_time_s = t;
     if (!r.samples.empty()) intervals.push_back(t - r.samples.back().time_s);
-    r.samples.push_back({t, x, probe.force(), u.count});
+    r.samples.push_back({t, x, probe.force(), u.count, u.min_det_f});
     // The next deadline is one period on; after a stall longer than a period, restart from now
     // instead of firing a burst of late outputs.
     deadline += period;
     if (deadline + period < clock::now()) deadline = clock::now();
   }
   probe.stop();
+  r.wall_s = std::chrono::duration<double>(clock::now() - start).count();
+  // A last fold check of the final state (the thread's last one may be up to a check interval old).
+  if (!probe.last_update().blown_up) probe.check_fold();
   const HapticUpdate after = probe.last_update();
   if (after.blown_up && !r.blown_up) r.blown_up = true, r.message = after.message;
-  r.wall_s = std::chrono::duration<double>(clock::now() - start).count();
   r.intervals = interval_stats(intervals, 1 / o.rate_hz);
   if (r.samples.size() > 1)
     r.achieved_rate_hz = double(r.samples.size() - 1) / (r.samples.back().time_s - r.samples.front().time_s);
   r.updates = after.count - before.count;
   r.steps = after.steps - before.steps;
   r.update_rate_hz = r.wall_s > 0 ? double(r.updates) / r.wall_s : 0;
+  r.folded = after.folded_checks > before.folded_checks;
+  r.min_det_f = after.lowest_det_f;
+  r.fold_checks = after.fold_checks - before.fold_checks;
+  r.folded_checks = after.folded_checks - before.folded_checks;
+  r.fold_check_wall_s = after.fold_check_wall_s - before.fold_check_wall_s;
+  if (r.folded) {
+    r.first_fold_update = after.first_fold_update;
+    if (r.first_fold_time_s < 0) r.first_fold_time_s = r.wall_s;  // seen only by the last check
+  }
   return r;
 }
 

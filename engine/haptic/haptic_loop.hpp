@@ -35,6 +35,7 @@ struct HapticSample {
   Vec3 probe_m = Vec3::Zero();  ///< commanded probe position (m)
   Vec3 force_n = Vec3::Zero();  ///< force output (N)
   std::int64_t updates = 0;   ///< deformation updates done when it was output
+  double min_det_f = 1;       ///< smallest det F of the free elements at the last fold check
 };
 
 /// Wall-clock intervals between consecutive outputs (s).
@@ -55,10 +56,18 @@ struct HapticLoopResult {
   bool blown_up = false;
   std::string message;          ///< the blow-up, when blown_up
   bool realtime = false;        ///< the output loop ran at real-time priority
+  // The fold monitor (HapticUpdate's fold fields, over the whole run, a last check after it).
+  bool folded = false;          ///< some check found a free element with det F ≤ 0: the force is not the tissue's
+  double min_det_f = 1;         ///< smallest det F over the checks
+  double first_fold_time_s = -1;  ///< loop time at which the output loop first saw the fold (−1: never)
+  std::int64_t first_fold_update = -1;  ///< the probe's update count at the first folded check
+  std::int64_t fold_checks = 0, folded_checks = 0;
+  double fold_check_wall_s = 0;  ///< wall time of the checks (deformation thread)
 };
 
 /// Starts the probe's update thread, plays the trajectory for the run's length and stops it.
-/// A blow-up ends the loop early (blown_up, message); the samples so far are kept.
+/// A blow-up ends the loop early (blown_up, message); the samples so far are kept. A fold does
+/// not: the run goes on and `folded` says so (the output loop only reads the probe's flag).
 HapticLoopResult run_haptic_loop(HapticProbe& probe, const ProbeTrajectory& trajectory, const HapticLoopOptions& options);
 
 }  // namespace vb

@@ -7,12 +7,14 @@
 /// secant of equilibrium forces), kept symmetric and negative semi-definite (the tissue pushes
 /// back harder the deeper the probe goes).
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
 
+#include "engine/results/element_measures.hpp"
 #include "engine/sim/simulator.hpp"
 
 namespace vb {
@@ -21,6 +23,12 @@ struct HapticOptions {
   std::size_t probe = 0;            ///< the scene's indenter that is the probe (a sphere)
   int steps_per_update = 0;         ///< time steps between force readings; 0: solver.check_every
   double max_move_per_update = 0.25;  ///< largest probe move per update, in lattice spacings
+  /// The fold monitor (docs/HAPTICS.md, "Folding"): the deformation thread checks det F of the
+  /// free elements once the probe has moved this many spacings since the last check ...
+  double fold_check_move = 0.5;
+  /// ... and at least this often (s, wall clock) while it holds still: folding can develop while
+  /// the tissue relaxes under a held probe.
+  double fold_check_every_s = 0.25;
 };
 
 /// The probe's state after one deformation update.
@@ -34,6 +42,15 @@ struct HapticUpdate {
   std::int64_t steps = 0;                ///< time steps so far
   bool blown_up = false;                 ///< the state stopped being finite or physical
   std::string message;                   ///< why, when blown_up
+  // The fold monitor: det F of the free elements at the checks (check_folding).
+  std::int64_t fold_checks = 0;          ///< checks so far
+  double min_det_f = 1;                  ///< smallest det F at the last check (1 before any)
+  std::int64_t inverted_elements = 0;    ///< free elements with det F ≤ 0 at the last check
+  double lowest_det_f = 1;               ///< smallest det F over all checks
+  std::int64_t folded_checks = 0;        ///< checks that found an element with det F ≤ 0
+  std::int64_t first_fold_update = -1;   ///< `count` at the first such check; −1: never folded
+  double fold_check_wall_s = 0;          ///< wall time the checks took (s), download included
+  bool folded() const { return folded_checks > 0; }
 };
 
 class HapticProbe {
@@ -63,6 +80,9 @@ class HapticProbe {
   bool update();
   /// Blocks until `count` updates are done or the probe blew up; false on blow-up.
   bool wait_for_updates(std::int64_t count) const;
+  /// A fold check now (one state download, det F on the host), on the calling thread and not
+  /// while the thread runs; update() makes them on its own (HapticOptions::fold_check_move).
+  void check_fold();
 
   const Simulator& simulator() const { return sim_; }
   double spacing_m() const { return spacing_m_; }
@@ -73,11 +93,17 @@ class HapticProbe {
   void update_stiffness(const Vec3& dx, const Vec3& dF, std::int64_t contact_elements);
 
   HapticOptions options_;
+  const Lattice& lattice_;
+  const ElementArrays& elements_;
   Simulator sim_;
   double spacing_m_ = 0, F_ref_ = 0, wave_speed_ = 0, extent_m_ = 0, max_stiffness_n_m_ = 0;
   std::int64_t steps_per_update_ = 1;
   Eigen::Matrix3d K_ = Eigen::Matrix3d::Zero();
   Vec3 secant_from_m_ = Vec3::Zero(), secant_force_n_ = Vec3::Zero();  ///< probe and force before its last move
+  // The fold monitor's state (deformation thread only).
+  Vec3 fold_checked_at_m_ = Vec3::Zero();  ///< simulated probe position at the last check
+  std::chrono::steady_clock::time_point fold_checked_when_{};  ///< and its wall time
+  std::vector<double> fold_u_, fold_v_;    ///< downloaded state, kept to avoid reallocating
 
   mutable std::mutex mutex_;               ///< guards commanded_ and last_
   Vec3 commanded_m_ = Vec3::Zero();

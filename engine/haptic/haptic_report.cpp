@@ -1,16 +1,29 @@
 #include "engine/haptic/haptic_report.hpp"
 
+#include <cstdio>
+
 #include "io/csv_table.hpp"
 
 namespace vb {
 
 std::string haptic_log_csv(const HapticLoopResult& r) {
-  std::string text = csv_line({"time_s", "x_mm", "y_mm", "z_mm", "fx_n", "fy_n", "fz_n", "updates"});
+  std::string text = csv_line({"time_s", "x_mm", "y_mm", "z_mm", "fx_n", "fy_n", "fz_n", "updates", "min_det_f"});
   for (const HapticSample& s : r.samples) {
     const auto n = [](double x) { return shortest_number_text(x); };
     text += csv_line({n(s.time_s), n(1e3 * s.probe_m.x()), n(1e3 * s.probe_m.y()), n(1e3 * s.probe_m.z()),
-                      n(s.force_n.x()), n(s.force_n.y()), n(s.force_n.z()), std::to_string(s.updates)});
+                      n(s.force_n.x()), n(s.force_n.y()), n(s.force_n.z()), std::to_string(s.updates),
+                      n(s.min_det_f)});
   }
+  return text;
+}
+
+std::string haptic_fold_warning(const HapticLoopResult& r) {
+  if (!r.folded) return {};
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "the lattice folded under the probe at t = %.3f s (min det F %.3g): the force is not the "
+                "tissue's; press less deep or refine the spacing",
+                r.first_fold_time_s, r.min_det_f);
   return text;
 }
 
@@ -46,6 +59,15 @@ nlohmann::json haptic_summary_json(const HapticLoopResult& r, const HapticLoopOp
       {"final_probe_mm", {1e3 * last.probe_m.x(), 1e3 * last.probe_m.y(), 1e3 * last.probe_m.z()}},
       {"final_residual", last.residual},
       {"final_contact_elements", last.contact_elements},
+      {"folded", r.folded},
+      {"min_det_f", r.min_det_f},
+      {"final_min_det_f", last.min_det_f},
+      {"final_inverted_elements", last.inverted_elements},
+      {"first_fold_time_s", r.folded ? nlohmann::json(r.first_fold_time_s) : nlohmann::json(nullptr)},
+      {"first_fold_update", r.folded ? nlohmann::json(r.first_fold_update) : nlohmann::json(nullptr)},
+      {"fold_checks", r.fold_checks},
+      {"folded_checks", r.folded_checks},
+      {"fold_check_wall_s", r.fold_check_wall_s},
   };
   return j;
 }

@@ -8,10 +8,14 @@
 
 namespace vb {
 
-/// time_s,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n,updates — one row per force output.
+/// time_s,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n,updates,min_det_f — one row per force output.
 std::string haptic_log_csv(const HapticLoopResult& result);
 
-/// Rate, interval statistics, update rate and the outcome; `model` adds element count etc.
+/// The terminal warning for a run that folded the lattice (when and how deep, what to do);
+/// empty when it did not fold.
+std::string haptic_fold_warning(const HapticLoopResult& result);
+
+/// Rate, interval statistics, update rate and the outcome (blow-up, fold monitor); `elements` the model size.
 nlohmann::json haptic_summary_json(const HapticLoopResult& result, const HapticLoopOptions& options,
                                    const HapticProbe& probe, std::size_t elements);
 

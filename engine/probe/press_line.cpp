@@ -185,15 +185,10 @@ ProbeResult run_press_line(const Scene& scene, const Lattice& lattice, const Ele
           if (area[e] > 0 && indenter_signed_distance(ind, at, Vec3(x[3 * e], x[3 * e + 1], x[3 * e + 2])) <= kContactTol * h)
             sample.contact_area_m2 += area[e];
       }
-      // Folded elements: the spring lattice has no resistance to inversion, and a press that
-      // crushes the layer under the indenter can push an element through its neighbours into a
-      // softer, folded state (docs/PROBING.md, "Validity"); its force is not the tissue's.
-      for (std::size_t e = 0; e < lattice.element_count(); ++e) {
-        if (el.inverse_mass[e] == 0) continue;
-        const double J = deformation_gradient(lattice, u, e).determinant();
-        sample.min_det_f = std::min(sample.min_det_f, J);
-        if (J <= 0) ++sample.inverted_elements;
-      }
+      // Folded elements (det F ≤ 0): the force is not the tissue's (check_folding).
+      const FoldCheck fold = check_folding(lattice, u, el.inverse_mass);
+      sample.min_det_f = std::min(sample.min_det_f, fold.min_det_f);
+      sample.inverted_elements = fold.inverted_elements;
       press.min_det_f = std::min(press.min_det_f, sample.min_det_f);
       if (sample.inverted_elements > 0) {
         press.inverted = true;

@@ -1,6 +1,7 @@
 #include "engine/results/element_measures.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 
 namespace vb {
@@ -22,6 +23,17 @@ Eigen::Matrix3d deformation_gradient(const Lattice& lattice, const std::vector<d
   Eigen::FullPivLU<Eigen::Matrix3d> lu(B);
   if (lu.rank() < 3) return Eigen::Matrix3d::Identity();
   return A * lu.inverse();
+}
+
+FoldCheck check_folding(const Lattice& lattice, const std::vector<double>& u, const std::vector<double>& inverse_mass) {
+  FoldCheck c;
+  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+    if (inverse_mass[e] == 0) continue;
+    const double J = deformation_gradient(lattice, u, e).determinant();
+    c.min_det_f = std::min(c.min_det_f, J);
+    if (J <= 0) ++c.inverted_elements;
+  }
+  return c;
 }
 
 double compute_element_measures(const Lattice& lattice, const std::vector<double>& E, FinalState& st) {

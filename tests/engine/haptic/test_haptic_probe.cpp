@@ -1,12 +1,14 @@
 // The haptic probe (engine/haptic, docs/HAPTICS.md): its force at a held position must converge
 // to the quasi-static force of an ordinary run of the same press, its linearisation must predict
-// the force of a small further move, and a blow-up must be detected and reported, not rendered.
+// the force of a small further move, and a blow-up must be detected and reported, not rendered;
+// a press that folds the lattice must be reported as folded (and the run go on), a valid one not.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <iostream>
 
 #include "engine/error.hpp"
+#include "engine/haptic/haptic_bench.hpp"
 #include "engine/haptic/haptic_loop.hpp"
 #include "engine/haptic/haptic_probe.hpp"
 #include "engine/sim/run.hpp"
@@ -148,6 +150,52 @@ TEST(HapticProbe, BlowUpIsDetectedAndReported) {
   EXPECT_LT(r.wall_s, 4.0) << "the loop stops at the blow-up, not at the end of the run";
   EXPECT_FALSE(probe.update()) << "a blown-up probe does not update again";
   for (const HapticSample& sample : r.samples) EXPECT_TRUE(sample.force_n.allFinite());
+}
+
+/// The haptic sample's block (h = 2 mm, E = 3 kPa, held base, a 5 mm ball touching the top
+/// layer's centres; data-samples/haptic/block.toml), smaller: 16 × 16 × 15 elements. The probe is
+/// sent `depth` down and updated synchronously (the moves take depth / 0.5 mm updates), then held
+/// for `hold` updates; a last fold check reads the final state.
+HapticUpdate press_block(double depth, int hold) {
+  const Scene s = haptic_bench_scene(4096, Precision::Float);
+  const test::Model m = test::make_model(s);
+  HapticProbe probe(s, m.lattice, m.elements, test::cl_context());
+  probe.set_probe_position(s.indenters[0].start_m - Vec3(0, 0, depth));
+  const int moves = int(std::ceil(depth / (0.25 * s.model.spacing_m)));
+  for (int i = 0; i < moves + hold; ++i) EXPECT_TRUE(probe.update()) << probe.last_update().message;
+  probe.check_fold();
+  const HapticUpdate u = probe.last_update();
+  std::cout << depth * 1e3 << " mm press, " << m.lattice.element_count() << " elements: " << u.count
+            << " updates, force " << u.force_n.z() << " N, residual " << u.residual << "; " << u.fold_checks
+            << " fold checks, " << u.folded_checks << " folded (first at update " << u.first_fold_update
+            << "), lowest det F " << u.lowest_det_f << ", final " << u.min_det_f << " (" << u.inverted_elements
+            << " inverted), checks took " << 1e3 * u.fold_check_wall_s << " ms\n";
+  // The probe's moves alone trigger a check every half spacing (two updates of 0.25 h).
+  EXPECT_GE(u.fold_checks, moves / 2);
+  return u;
+}
+
+TEST(HapticProbe, DeepPressIsReportedFolded) {
+  // 8 mm with the 5 mm ball folds the layer under it (docs/VALIDATION.md, "the haptic sample in
+  // triangle contact": det F −0.54 in vertex contact). A validity warning, not a blow-up.
+  const HapticUpdate u = press_block(0.008, 200);
+  EXPECT_FALSE(u.blown_up) << u.message;
+  EXPECT_TRUE(u.folded());
+  EXPECT_LE(u.lowest_det_f, 0.0);
+  EXPECT_GT(u.first_fold_update, 0);
+  EXPECT_LE(u.first_fold_update, u.count);
+  EXPECT_GE(u.folded_checks, 1);
+}
+
+TEST(HapticProbe, ShallowPressIsNotFolded) {
+  // 2 mm: min det F about 0.57 at equilibrium (docs/VALIDATION.md).
+  const HapticUpdate u = press_block(0.002, 200);
+  EXPECT_FALSE(u.blown_up) << u.message;
+  EXPECT_FALSE(u.folded());
+  EXPECT_EQ(u.inverted_elements, 0);
+  EXPECT_GT(u.lowest_det_f, 0.3);
+  EXPECT_LT(u.lowest_det_f, 0.9) << "the press compresses the layer under the ball";
+  EXPECT_EQ(u.first_fold_update, -1);
 }
 
 TEST(HapticTrajectory, InterpolatesLinearlyAndHoldsAtTheEnds) {
