@@ -46,16 +46,16 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
 #define REAL_CONTACT_TOL ((real)1e-3)
 
 // Parameters every stepping kernel takes, in this order (the host sets them in one place).
-// Hyperelastic data (tissue_of, materials, Qs, Fs, hourglass) are 1-element placeholders when
+// Hyperelastic data (tissue_of, materials, Qs, Cs, hourglass) are 1-element placeholders when
 // VB_HYPER is 0; tissue_of and materials are real when VB_BIPHASIC is 1; rest_offset (m, lattice
 // frame) is a placeholder when VB_REST_OFFSET is 0.
 #define VB_LATTICE_PARAMS                                                                        \
   global const real *E, global const uint *cell_of, global const int *grid, int sy, int sz,    \
       real h, real dashpot_ratio, real4 gravity, real damping, real4 origin,                   \
       global const uchar *tissue_of, global const real *materials, global const real4 *Qs,     \
-      global const real4 *Fs, real hourglass, global const real4 *rest_offset
+      global const real4 *Cs, real hourglass, global const real4 *rest_offset
 #define VB_LATTICE_ARGS \
-  E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity, damping, origin, tissue_of, materials, Qs, Fs, hourglass, \
+  E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity, damping, origin, tissue_of, materials, Qs, Cs, hourglass, \
       rest_offset
 // A pending volume projection (kernels/volume.cl, VB_VOLUME_FOLD): the state in memory is the
 // unprojected (u, v), and its readers see what volume_apply would have stored,

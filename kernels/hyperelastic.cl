@@ -1,7 +1,7 @@
 // Hyperelastic elements (compiled when VB_HYPER is 1). Pass 1, element_stress, computes each
 // element's deformation gradient by least squares over its existing neighbours,
 //   F = A·B⁻¹,  A = Σ Δx ΔXᵀ,  B = Σ ΔX ΔXᵀ  (ΔX = h·d rest offsets, Δx deformed),
-// the law's first Piola-Kirchhoff stress P(F), and Q = V·P·B⁻¹. The energy V·W(F_e) then puts
+// the law's first Piola-Kirchhoff stress P(F), and Q = V·P·B⁻¹ (stored with C = FᵀF: hyper_store). The energy V·W(F_e) then puts
 // force −Q_e·(h·d) on each neighbour at offset h·d and +Q_e·Σ h·d on the element itself (pass 2
 // gathers them in lattice_force): total force and torque vanish and rigid motions give none.
 //
@@ -100,8 +100,39 @@ inline real4 mat3_apply_dir(mat3 a, int d, real h) {
   return r;
 }
 
+// |F·r| from C = FᵀF (diag = C00, C11, C22; off = C01, C02, C12): √(rᵀ·C·r), floored at 0 against
+// rounding for a crushed element.
+inline real stretched_length(real4 diag, real4 off, real4 r) {
+  const real s = r.x * r.x * diag.x + r.y * r.y * diag.y + r.z * r.z * diag.z +
+                 2 * (r.x * r.y * off.x + r.x * r.z * off.y + r.y * r.z * off.z);
+  return sqrt(fmax(s, (real)0));
+}
+
+// The same for r = h·d, with only d's nonzero terms (d is a constant once the loop is unrolled:
+// a face direction is h·√C_aa, 1 of the 6 terms; the dropped terms are exact zeros).
+inline real stretched_length_dir(real4 diag, real4 off, int d, real h) {
+  const int x = VB_DIR[d][0], y = VB_DIR[d][1], z = VB_DIR[d][2];
+  real s = 0;
+  if (x) s += diag.x;
+  if (y) s += diag.y;
+  if (z) s += diag.z;
+  if (x * y) s += (real)(2 * x * y) * off.x;
+  if (x * z) s += (real)(2 * x * z) * off.y;
+  if (y * z) s += (real)(2 * y * z) * off.z;
+  return h * sqrt(fmax(s, (real)0));
+}
+
 inline void mat3_store(global real4* rows, uint e, mat3 a) {
   for (int i = 0; i < 3; ++i) rows[3 * e + i] = (real4)(a.m[i][0], a.m[i][1], a.m[i][2], 0);
+}
+
+// The force pass's per-element data (pass 2 reads it for all 26 neighbours, so it is packed into 4
+// real4): rows of Q with C = FᵀF's diagonal in w, then (C01, C02, C12, 1 if the element's tissue is
+// hyperelastic else 0). C gives the hourglass control's |F·r₀| = √(r₀ᵀ·C·r₀) without F (3 loads
+// fewer per neighbour) and the flag the neighbour's law without its tissue id and material row.
+inline void hyper_store(global real4* Qs, global real4* Cs, uint e, mat3 Q, mat3 C, int hyper) {
+  for (int i = 0; i < 3; ++i) Qs[3 * e + i] = (real4)(Q.m[i][0], Q.m[i][1], Q.m[i][2], C.m[i][i]);
+  Cs[e] = (real4)(C.m[0][1], C.m[0][2], C.m[1][2], hyper ? 1 : 0);
 }
 
 inline mat3 mat3_load(global const real4* rows, uint e) {
@@ -271,8 +302,9 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
   if (detB < (real)0.5) return false;
   *Bi = mat3_inverse(B, detB);
   *F = mat3_mul(A, *Bi);
+  const real inv_h = 1 / h;  // one division instead of nine (each a call sequence on NVIDIA)
   for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) F->m[a][b] /= h;
+    for (int b = 0; b < 3; ++b) F->m[a][b] *= inv_h;
   return true;
 }
 
@@ -281,13 +313,13 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
 // homogeneous stress is balanced by forces on the surface elements alone, as plates apply them.
 // With VB_REST_OFFSET the element rests in the unloaded state, whose gradient from the lattice is
 // F₀ (rest_frame: rows of R₀ = F₀⁻¹, J₀ = det F₀ in row 0's w): the law sees F·R₀ and the energy
-// J₀·V·W(F·R₀) gives Q = J₀·V·P(F·R₀)·R₀ᵀ·B⁻¹ on the same lattice offsets. F_out is the
+// J₀·V·W(F·R₀) gives Q = J₀·V·P(F·R₀)·R₀ᵀ·B⁻¹ on the same lattice offsets. C_out is that of the
 // deformation from rest (F·R₀), which the hourglass control applies to the rest connections.
 // With VB_VOLUME_FOLD, u may have a volume projection pending: its gradient pend_g and scalars
 // {λ, μ, …} (all zero when none is).
 kernel void element_stress(global const real4* u, global const uchar* tissue_of, global const real* materials,
                            global const uint* cell_of, global const int* grid, int sy, int sz, real h,
-                           global real4* Q_out, global real4* F_out, uint n, global const real4* rest_frame
+                           global real4* Q_out, global real4* C_out, uint n, global const real4* rest_frame
 #if VB_VOLUME_FOLD
                            , global const real4* pend_g, global const real* pend_scalars
 #endif
@@ -305,8 +337,7 @@ kernel void element_stress(global const real4* u, global const uchar* tissue_of,
   uint present = 0;
   // spring tissue, or neighbours that do not span 3-D: no element stress
   if (!VB_LAW_HYPER(law) || !fit_gradient(u, e, cell_of, grid, sy, sz, h, &F, &Bi, &present, VB_STRESS_PENDING)) {
-    mat3_store(Q_out, e, mat3_zero());
-    mat3_store(F_out, e, mat3_identity());
+    hyper_store(Q_out, C_out, e, mat3_zero(), mat3_identity(), VB_LAW_HYPER(law));
     return;
   }
 #if VB_REST_OFFSET
@@ -314,7 +345,6 @@ kernel void element_stress(global const real4* u, global const uchar* tissue_of,
   const real J0 = rest_frame[3 * e].w;
   F = mat3_mul(F, R0);
 #endif
-  mat3_store(F_out, e, F);
   const real J = mat3_det(F);
   const mat3 C = mat3_transpose_mul(F, F);
   const mat3 S = law == 1 ? stress_invariants(C, J, (real)0.5 * mat[2], (real)-0.5 * mat[3])
@@ -335,7 +365,7 @@ kernel void element_stress(global const real4* u, global const uchar* tissue_of,
   const real wh = (real)0.125 * cells * h;
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) Q.m[a][b] *= wh;
-  mat3_store(Q_out, e, Q);
+  hyper_store(Q_out, C_out, e, Q, C, 1);
 }
 
 #if VB_REST_OFFSET

@@ -47,7 +47,7 @@ real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, g
   const int law_i = (int)mat_i[0];
 #endif
 #if VB_HYPER
-  const mat3 Fi = mat3_load(Fs, e);
+  const real4 Ci_diag = (real4)(Qs[3 * e].w, Qs[3 * e + 1].w, Qs[3 * e + 2].w, 0), Ci_off = Cs[e];
   real4 own_offsets = (real4)(0);
 #endif
 #if VB_REST_OFFSET
@@ -94,21 +94,28 @@ real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, g
     const real4 r0 = hd;
     const real rest = h * VB_DIR_LEN[d];
 #endif
-#if VB_HYPER || VB_BIPHASIC
+#if VB_BIPHASIC  // biphasic ends need the neighbour's own c3, εc
     global const real* mat_j = materials + VB_MAT_STRIDE * tissue_of[j];
     const int law_j = (int)mat_j[0];
 #endif
 #if VB_HYPER
-#if VB_REST_OFFSET
-#define VB_APPLY_R0(M) mat3_apply(M, r0)
+    const mat3 Qj = mat3_load(Qs, (uint)j);  // zero for spring tissue
+    const real4 Cj_diag = (real4)(Qs[3 * j].w, Qs[3 * j + 1].w, Qs[3 * j + 2].w, 0), Cj_off = Cs[j];
+#if VB_BIPHASIC
+    const int hyper_j = VB_LAW_HYPER(law_j);
 #else
-#define VB_APPLY_R0(M) mat3_apply_dir(M, d, h)  // r0 = h·d
+    const int hyper_j = Cj_off.w != 0;  // the neighbour's law without its tissue id and material row
+#endif
+#if VB_REST_OFFSET
+#define VB_STRETCHED(diag, off) stretched_length(diag, off, r0)
+#else
+#define VB_STRETCHED(diag, off) stretched_length_dir(diag, off, d, h)  // r0 = h·d
 #endif
     real magnitude = !VB_LAW_HYPER(law_i) ? spring_end(law_i, mat_i, k, len, rest)
-                                          : hourglass * k * (len - norm3(VB_APPLY_R0(Fi)));
-    magnitude += !VB_LAW_HYPER(law_j) ? spring_end(law_j, mat_j, k, len, rest)
-                                      : hourglass * k * (len - norm3(VB_APPLY_R0(mat3_load(Fs, (uint)j))));
-    if (VB_LAW_HYPER(law_j)) f += present * mat3_apply_dir(mat3_load(Qs, (uint)j), d, h);
+                                          : hourglass * k * (len - VB_STRETCHED(Ci_diag, Ci_off));
+    magnitude += !hyper_j ? spring_end(law_j, mat_j, k, len, rest)
+                          : hourglass * k * (len - VB_STRETCHED(Cj_diag, Cj_off));
+    f += present * mat3_apply_dir(Qj, d, h);
     own_offsets += present * hd;
 #elif VB_BIPHASIC
     real magnitude = spring_end(law_i, mat_i, k, len, rest) + spring_end(law_j, mat_j, k, len, rest);

@@ -32,6 +32,9 @@ constexpr int kStepLattice = 4;                              // step kernels: 4 
 constexpr int kStepIndenter = kStepLattice + kLatticeArgs;   // then dt, n
 constexpr int kCheckLattice = 2;                             // check_state: u, v first
 constexpr int kCheckIndenter = kCheckLattice + kLatticeArgs; // then partial, partial_arg, n
+// With VB_TRI_CONTACT the stepping and check kernels end with VB_TRI_PARAMS
+// (kernels/triangle_contact.cl): corner forces, CSR start, corners, triangle count.
+constexpr int kTriangleArgs = 4;
 constexpr int kCheckVolume = kCheckIndenter + kIndenterArgs + 3;  // VB_VOLUME: grad, scalars
 // kernels/volume.cl: volume_partials takes u, v, the lattice parameters, then these.
 constexpr int kVolumeSlots = 5, kVolumeScalars = 4;
@@ -67,7 +70,7 @@ std::string mib(double bytes) { return std::to_string(static_cast<long long>(byt
 
 std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision, bool hyperelastic) {
   const std::size_t real = precision == Precision::Double ? 8 : 4;
-  const std::size_t hyper = hyperelastic ? 2 * 3 * 4 * real + 1 : 0;  // F and Q rows, tissue id
+  const std::size_t hyper = hyperelastic ? 4 * 4 * real + 1 : 0;  // Q rows and C (hyper_store), tissue id
   return elements * (4 * 4 * real + real + 4 + hyper) + cells * 4;
 }
 
@@ -287,7 +290,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     stress_ = cl::Kernel(program_, "element_stress");
     set_element_fit_args(stress_);
     stress_.setArg(8, Q_);
-    stress_.setArg(9, F_);
+    stress_.setArg(9, C_);
     stress_.setArg(10, cl_uint(n_));
     stress_.setArg(11, rest_frame_);
   }
@@ -331,7 +334,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   }
   if (friction) {  // check_state's friction_dt, just before VB_TRI_PARAMS (kernels/checks.cl)
     const int last = int(check_.getInfo<CL_KERNEL_NUM_ARGS>());
-    set_real(check_, last - 1 - (tri_contact_ ? 4 : 0), dt_.dt_s);
+    set_real(check_, last - 1 - (tri_contact_ ? kTriangleArgs : 0), dt_.dt_s);
   }
   if (volume_) make_volume_buffers(surface_);
   if (!scene.tori.empty()) make_contact_area_buffer();
@@ -591,9 +594,10 @@ void Simulator::make_hyperelastic_buffers(const ElementArrays& el) {
   for (const auto& row : el.material_table) table.insert(table.end(), row.begin(), row.end());
   if (!per_tissue) table.assign(12, 0.0);
   materials_ = make_real_buffer(table);
-  const std::size_t matrix_bytes = (hyper_ ? 3 * n_ : 1) * 4 * real_size_;  // 3 rows of real4
-  Q_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, matrix_bytes);
-  F_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, matrix_bytes);
+  // kernels/hyperelastic.cl, hyper_store: Q's 3 rows (C = FᵀF's diagonal in w), C's other entries
+  const std::size_t row_bytes = (hyper_ ? n_ : 1) * 4 * real_size_;
+  Q_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, 3 * row_bytes);
+  C_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, row_bytes);
 }
 
 cl::Buffer Simulator::make_real_buffer(const std::vector<double>& values) const {
@@ -652,7 +656,7 @@ void Simulator::set_lattice_args(cl::Kernel& k, int a) {
   k.setArg(a + 10, tissue_);
   k.setArg(a + 11, materials_);
   k.setArg(a + 12, Q_);
-  k.setArg(a + 13, F_);
+  k.setArg(a + 13, C_);
   set_real(k, a + 14, scene_.solver.hourglass);
   k.setArg(a + 15, rest_offset_);
 }
@@ -1035,14 +1039,13 @@ void Simulator::make_triangle_contact_buffers() {
   set_real(tri_kernel_, 8, lattice_.rotation.determinant() < 0 ? -1.0 : 1.0);  // outward in the lattice frame
   tri_kernel_.setArg(9, indenters_);
   tri_kernel_.setArg(11, corner_force_);
-  // The stepping and check kernels end with VB_TRI_PARAMS: corner forces, CSR start, corners, count.
   for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_, &check_}) {
     if (!(*k)()) continue;
-    const int last = int(k->getInfo<CL_KERNEL_NUM_ARGS>());
-    k->setArg(last - 4, corner_force_);
-    k->setArg(last - 3, tri_start_);
-    k->setArg(last - 2, tri_corner_);
-    k->setArg(last - 1, cl_uint(tri_triangles_));
+    const int first = int(k->getInfo<CL_KERNEL_NUM_ARGS>()) - kTriangleArgs;  // VB_TRI_PARAMS
+    k->setArg(first + 0, corner_force_);
+    k->setArg(first + 1, tri_start_);
+    k->setArg(first + 2, tri_corner_);
+    k->setArg(first + 3, cl_uint(tri_triangles_));
   }
 }
 

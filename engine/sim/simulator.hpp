@@ -63,7 +63,7 @@ struct StateCheck {
 };
 
 /// Device bytes a model of `elements` elements in a padded grid of `cells` voxels needs
-/// (hyperelastic models also store F and Q per element).
+/// (hyperelastic models also store Q and C = FᵀF per element).
 std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision,
                                    bool hyperelastic = false);
 /// Extra device bytes of the volume constraint (kernels/volume.cl): triangles, the per-surface-
@@ -205,7 +205,7 @@ class Simulator {
 
   cl::Buffer u_, v_, u_tmp_, v_tmp_, E_, cell_, grid_, partial_, partial_arg_;
   bool hyper_ = false;
-  cl::Buffer tissue_, materials_, Q_, F_;
+  cl::Buffer tissue_, materials_, Q_, C_;
   cl::Buffer indenters_;  ///< rigid-obstacle table: indenters and tori (lattice frame)
   std::vector<IndenterMotion> motion_;  ///< per indenter, what its row holds now
   std::vector<std::size_t> path_segment_;  ///< per indenter with a trajectory: the segment its row holds
