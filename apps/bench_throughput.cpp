@@ -111,6 +111,32 @@ double copy_bandwidth(const ClContext& cl, std::size_t bytes) {
   return 2.0 * double(n * 16) * reps / seconds_since(t0);
 }
 
+/// The cost of a launch that does nothing (the copy kernel over 0 elements, one work-group): host
+/// time per enqueue in a 16-launch batch (short enough not to block on a full queue) and the
+/// device's throughput over 2,000 launches. A step of L launches cannot be faster than L times
+/// the larger of the two, however fast its kernels are.
+void print_launch_floor(const ClContext& cl) {
+  cl::Program p = build_program(cl, {"common.cl", "bandwidth.cl"}, "", "-DVB_DOUBLE=0");
+  cl::Kernel k(p, "copy_bandwidth");
+  cl::Buffer a(cl.context, CL_MEM_READ_WRITE, 16);
+  k.setArg(0, a); k.setArg(1, a); k.setArg(2, cl_uint(0));
+  const auto launches = [&](int count) {
+    for (int r = 0; r < count; ++r) cl.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(256), cl::NDRange(256));
+  };
+  launches(100);
+  cl.queue.finish();
+  auto t0 = std::chrono::steady_clock::now();
+  launches(16);
+  const double host_s = seconds_since(t0) / 16;
+  cl.queue.finish();
+  const int many = 2000;
+  t0 = std::chrono::steady_clock::now();
+  launches(many);
+  cl.queue.finish();
+  std::printf("launch floor: empty kernel %.2f us/launch host enqueue (16-launch batch), %.2f us/launch over %d launches\n",
+              1e6 * host_s, 1e6 * seconds_since(t0) / many, many);
+}
+
 /// Bytes a Heun step must move per element, counting each element's own state once per stage
 /// (neighbour reads are served from cache): stage 1 reads u, v, E, cell, grid and writes ũ, ṽ;
 /// stage 2 reads u, v, ũ, ṽ, E, cell, grid and writes u, v. Hyperelastic tissues add, per
@@ -161,6 +187,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
   const double bandwidth = copy_bandwidth(cl, std::min<std::size_t>(cl.info.max_allocation_bytes / 2, o.quick ? 64u << 20 : 512u << 20));
   result.copy_bandwidth_gb_s = bandwidth / 1e9;
   std::printf("copy bandwidth: %.1f GB/s\n", bandwidth / 1e9);
+  if (o.profile) print_launch_floor(cl);
 
   std::vector<BenchCase> cases;
   for (int edge : sizes) {

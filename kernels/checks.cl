@@ -60,7 +60,7 @@ VB_INLINE void torus_check(real4* f, real4 x, global const real* table, int i, r
 #endif
 
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
-void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS,
+void check_state(global const real4* u, global const real4* v, VB_LATTICE_KERNEL_PARAMS,
                  VB_INDENTER_PARAMS, global real* partial, global int* partial_arg, uint n
 #if VB_VOLUME
                  , global const real4* volume_grad, global const real* volume_scalars
@@ -75,6 +75,7 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_PARAMS
                  , real friction_dt  // the steps' dt (s): sets the slip speed an indenter's friction tells
 #endif
                  VB_TRI_PARAMS) {
+  VB_UNPACK_LATTICE;
   local real s[VB_CHECK_SLOTS][VB_CHECK_WG];
   local int s_arg[VB_CHECK_WG];
   const uint e = get_global_id(0), l = get_local_id(0);

@@ -57,6 +57,23 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
 #define VB_LATTICE_ARGS \
   E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity, damping, origin, tissue_of, materials, Qs, Cs, hourglass, \
       rest_offset
+// What kernels take instead: the model's arrays in one buffer, the arena (engine/sim/device_arena.hpp:
+// NVIDIA's OpenCL spends ~0.35 µs of host time per buffer argument of every launch), with each
+// array's offset in units of VB_ARENA_UNIT bytes in `at`: E, cell_of, grid, tissue_of, materials,
+// Q rows, C, rest offsets. VB_UNPACK_LATTICE at the top of a kernel names them as above.
+#define VB_ARENA_AT(arena, slot) ((arena) + (size_t)(slot) * VB_ARENA_UNIT)
+#define VB_LATTICE_KERNEL_PARAMS                                                                 \
+  global const uchar *arena, uint8 at, int sy, int sz, real h, real dashpot_ratio, real4 gravity, \
+      real damping, real4 origin, real hourglass
+#define VB_UNPACK_LATTICE                                                                \
+  global const real* E = (global const real*)VB_ARENA_AT(arena, at.s0);                \
+  global const uint* cell_of = (global const uint*)VB_ARENA_AT(arena, at.s1);           \
+  global const int* grid = (global const int*)VB_ARENA_AT(arena, at.s2);                \
+  global const uchar* tissue_of = VB_ARENA_AT(arena, at.s3);                            \
+  global const real* materials = (global const real*)VB_ARENA_AT(arena, at.s4);         \
+  global const real4* Qs = (global const real4*)VB_ARENA_AT(arena, at.s5);              \
+  global const real4* Cs = (global const real4*)VB_ARENA_AT(arena, at.s6);              \
+  global const real4* rest_offset = (global const real4*)VB_ARENA_AT(arena, at.s7)
 // A pending volume projection (kernels/volume.cl, VB_VOLUME_FOLD): the state in memory is the
 // unprojected (u, v), and its readers see what volume_apply would have stored,
 //   u + λ·(w·g),  v − μ·(w·g)   (g = pend_g[j], zero off the surface; w = u.w),

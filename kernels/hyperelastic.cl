@@ -1,9 +1,10 @@
 // Hyperelastic elements (compiled when VB_HYPER is 1). Pass 1, element_stress, computes each
 // element's deformation gradient by least squares over its existing neighbours,
 //   F = A·B⁻¹,  A = Σ Δx ΔXᵀ,  B = Σ ΔX ΔXᵀ  (ΔX = h·d rest offsets, Δx deformed),
-// the law's first Piola-Kirchhoff stress P(F), and Q = V·P·B⁻¹ (stored with C = FᵀF: hyper_store). The energy V·W(F_e) then puts
-// force −Q_e·(h·d) on each neighbour at offset h·d and +Q_e·Σ h·d on the element itself (pass 2
-// gathers them in lattice_force): total force and torque vanish and rigid motions give none.
+// the law's first Piola-Kirchhoff stress P(F), and Q = V·P·B⁻¹ (stored with C = FᵀF: hyper_store).
+// The energy V·W(F_e) then puts force −Q_e·(h·d) on each neighbour at offset h·d and +Q_e·Σ h·d on
+// the element itself (pass 2 gathers them in lattice_force): total force and torque vanish and
+// rigid motions give none.
 //
 // Material table (global const real*, VB_MAT_STRIDE reals per tissue):
 //   0 law (0 linear springs, 1 neo-Hookean/Mooney-Rivlin by invariants, 2 Ogden by stretches,
@@ -308,7 +309,14 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
   return true;
 }
 
-// Pass 1: per-element F and Q (rows of 3×3 matrices stored as 3 real4 each). The element's volume
+// The arena's arrays the gradient fit reads (kernels/common.cl, VB_UNPACK_LATTICE).
+#define VB_UNPACK_FIT                                                                    \
+  global const uint* cell_of = (global const uint*)VB_ARENA_AT(arena, at.s1);           \
+  global const int* grid = (global const int*)VB_ARENA_AT(arena, at.s2);                \
+  global const uchar* tissue_of = VB_ARENA_AT(arena, at.s3);                            \
+  global const real* materials = (global const real*)VB_ARENA_AT(arena, at.s4)
+
+// Pass 1: per-element Q and C (hyper_store; in the arena, kernels/common.cl). The element's volume
 // is w·h³, w = (complete dual cells around it)/8 (engine/lattice/dual_cells.hpp): then a
 // homogeneous stress is balanced by forces on the surface elements alone, as plates apply them.
 // With VB_REST_OFFSET the element rests in the unloaded state, whose gradient from the lattice is
@@ -317,13 +325,15 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
 // deformation from rest (F·R₀), which the hourglass control applies to the rest connections.
 // With VB_VOLUME_FOLD, u may have a volume projection pending: its gradient pend_g and scalars
 // {λ, μ, …} (all zero when none is).
-kernel void element_stress(global const real4* u, global const uchar* tissue_of, global const real* materials,
-                           global const uint* cell_of, global const int* grid, int sy, int sz, real h,
-                           global real4* Q_out, global real4* C_out, uint n, global const real4* rest_frame
+kernel void element_stress(global const real4* u, global uchar* arena, uint8 at, int sy, int sz, real h, uint n,
+                           global const real4* rest_frame
 #if VB_VOLUME_FOLD
                            , global const real4* pend_g, global const real* pend_scalars
 #endif
 ) {
+  VB_UNPACK_FIT;
+  global real4* Q_out = (global real4*)VB_ARENA_AT(arena, at.s5);  // written here (hyper_store)
+  global real4* C_out = (global real4*)VB_ARENA_AT(arena, at.s6);
   const uint e = get_global_id(0);
   if (e >= n) return;
 #if VB_VOLUME_FOLD
@@ -372,9 +382,9 @@ kernel void element_stress(global const real4* u, global const uchar* tissue_of,
 // The unloaded state's frame per element, once per rest state: R₀ = F₀⁻¹ (rows, 3 real4) and
 // J₀ = det F₀ (row 0's w), F₀ the same least-squares fit of the rest offsets u0 (identity for
 // spring tissue and thin strands, which element_stress does not use).
-kernel void rest_frame(global const real4* u0, global const uchar* tissue_of, global const real* materials,
-                       global const uint* cell_of, global const int* grid, int sy, int sz, real h,
+kernel void rest_frame(global const real4* u0, global const uchar* arena, uint8 at, int sy, int sz, real h,
                        global real4* frame_out, uint n) {
+  VB_UNPACK_FIT;
   const uint e = get_global_id(0);
   if (e >= n) return;
   const int law = (int)materials[VB_MAT_STRIDE * tissue_of[e]];

@@ -136,8 +136,9 @@ inline void explicit_stage(global const real4* u, global const real4* v, global 
 }
 
 kernel void euler_step(global const real4* u, global const real4* v, global real4* u_out,
-                       global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
+                       global real4* v_out, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
                        uint n VB_TRI_PARAMS) {
+  VB_UNPACK_LATTICE;
   explicit_stage(u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1, VB_NO_PENDING VB_TRI_ARGS);
 }
 
@@ -154,8 +155,9 @@ kernel void euler_step(global const real4* u, global const real4* v, global real
 #endif
 
 kernel VB_STEP_ATTR void heun_predict(global const real4* u, global const real4* v, global real4* u_pred,
-                                      global real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
+                                      global real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
                                       uint n VB_FOLD_PARAMS(state) VB_TRI_PARAMS) {
+  VB_UNPACK_LATTICE;
 #if VB_SPLIT > 1
   local real4 share[VB_SPLIT_WG];
   const uint e = split_element();
@@ -178,8 +180,9 @@ kernel VB_STEP_ATTR void heun_predict(global const real4* u, global const real4*
 }
 
 kernel VB_STEP_ATTR void heun_correct(global real4* u, global real4* v, global const real4* u_pred,
-                                      global const real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS,
+                                      global const real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS,
                                       real dt, uint n VB_FOLD_PARAMS(state) VB_FOLD_PARAMS(pred) VB_TRI_PARAMS) {
+  VB_UNPACK_LATTICE;
 #if VB_SPLIT > 1
   local real4 share[VB_SPLIT_WG];
   const uint e = split_element();

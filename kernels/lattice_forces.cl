@@ -261,8 +261,9 @@ inline void contact_project_all(real4* ui, real4* vi, real4 X, global const real
 #endif
 
 // Test entry point: lattice forces only (N), for comparison with the host reference.
-kernel void lattice_forces(global const real4* u, global const real4* v, VB_LATTICE_PARAMS, global real4* f_out,
+kernel void lattice_forces(global const real4* u, global const real4* v, VB_LATTICE_KERNEL_PARAMS, global real4* f_out,
                            uint n) {
+  VB_UNPACK_LATTICE;
   const uint e = get_global_id(0);
   if (e >= n) return;
   f_out[e] = lattice_force(e, u[e], v[e], u, v, VB_LATTICE_ARGS);

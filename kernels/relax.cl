@@ -7,8 +7,9 @@
 // critical damping of the lowest mode (the Rayleigh quotient the check kernel sums), updated at
 // each check. Gravity still uses the real mass (u.w), so the equilibrium is the real one.
 kernel void relax_step(global const real4* u, global const real4* v, global real4* u_out,
-                       global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
+                       global real4* v_out, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
                        uint n, global const real* relax_scale, real c VB_TRI_PARAMS) {
+  VB_UNPACK_LATTICE;
   const uint e = get_global_id(0);
   if (e >= n) return;
   real4 ui = u[e], vi = v[e];

@@ -97,10 +97,23 @@ inline void volume_item_values(uint i, global const real4* u, global const real4
   global const uint *triangles, uint n_triangles, global const uint *surface_elements,          \
       global const uint *incident_start, global const VB_INCIDENT *incident, uint n_surface, real4 centre
 #define VB_VOLUME_MESH_ARGS triangles, n_triangles, surface_elements, incident_start, incident, n_surface, centre
+// What kernels take instead: the mesh's arrays in one buffer (engine/sim/device_arena.hpp), their
+// offsets in `mesh_at` (triangles, surface elements, incident start, incident).
+#define VB_VOLUME_MESH_KERNEL_PARAMS \
+  global const uchar *mesh, uint4 mesh_at, uint n_triangles, uint n_surface, real4 centre
+#define VB_UNPACK_SURFACE \
+  global const uint* surface_elements = (global const uint*)VB_ARENA_AT(mesh, mesh_at.s1)
+#define VB_UNPACK_MESH                                                                       \
+  VB_UNPACK_SURFACE;                                                                         \
+  global const uint* triangles = (global const uint*)VB_ARENA_AT(mesh, mesh_at.s0);          \
+  global const uint* incident_start = (global const uint*)VB_ARENA_AT(mesh, mesh_at.s2);     \
+  global const VB_INCIDENT* incident = (global const VB_INCIDENT*)VB_ARENA_AT(mesh, mesh_at.s3)
 
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
-void volume_partials(global const real4* u, global const real4* v, VB_LATTICE_PARAMS, VB_VOLUME_MESH_PARAMS,
+void volume_partials(global const real4* u, global const real4* v, VB_LATTICE_KERNEL_PARAMS, VB_VOLUME_MESH_KERNEL_PARAMS,
                      global real4* grad, int with_force, global real* partial) {
+  VB_UNPACK_LATTICE;
+  VB_UNPACK_MESH;
   local real s[VB_VOLUME_SLOTS * VB_CHECK_WG];
   const uint l = get_local_id(0);
   real value[VB_VOLUME_SLOTS];
@@ -146,9 +159,10 @@ inline void volume_apply_one(uint e, global real4* u, global real4* v, real4 g, 
 }
 
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
-void volume_apply(global real4* u, global real4* v, global const uint* surface_elements, uint n_surface,
+void volume_apply(global real4* u, global real4* v, global const uchar* mesh, uint4 mesh_at, uint n_surface,
                   global const real4* grad, global const real* partial, uint groups, real rest_volume,
                   global real* scalars) {
+  VB_UNPACK_SURFACE;
   local real s[VB_VOLUME_SLOTS * VB_CHECK_WG];
   const uint i = get_global_id(0), l = get_local_id(0);
   real out[4];
@@ -183,9 +197,11 @@ inline int partials_counted(global const real4* u, global const real4* v, VB_LAT
 }
 
 kernel __attribute__((reqd_work_group_size(VB_VOLUME_WG, 1, 1)))
-void volume_project(global real4* u, global real4* v, VB_LATTICE_PARAMS, VB_VOLUME_MESH_PARAMS,
+void volume_project(global real4* u, global real4* v, VB_LATTICE_KERNEL_PARAMS, VB_VOLUME_MESH_KERNEL_PARAMS,
                     global real4* grad, global real* partial, real rest_volume, global real* scalars,
                     volatile global uint* groups_done) {
+  VB_UNPACK_LATTICE;
+  VB_UNPACK_MESH;
   local real s[VB_VOLUME_SLOTS * VB_VOLUME_WG];
   local int last;
   const uint l = get_local_id(0);
@@ -219,9 +235,11 @@ void volume_project(global real4* u, global real4* v, VB_LATTICE_PARAMS, VB_VOLU
 // λ, μ, V, p into `scalars` by the last work-group, summed as volume_apply sums them (work-groups
 // of VB_CHECK_WG, so the same partials in the same order: the same values as the two-launch form).
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
-void volume_pending(global const real4* u, global const real4* v, VB_LATTICE_PARAMS, VB_VOLUME_MESH_PARAMS,
+void volume_pending(global const real4* u, global const real4* v, VB_LATTICE_KERNEL_PARAMS, VB_VOLUME_MESH_KERNEL_PARAMS,
                     global real4* grad, global real* partial, real rest_volume, global real* scalars,
                     volatile global uint* groups_done) {
+  VB_UNPACK_LATTICE;
+  VB_UNPACK_MESH;
   local real s[VB_VOLUME_SLOTS * VB_CHECK_WG];
   local int last;
   const uint l = get_local_id(0);

@@ -29,7 +29,7 @@ if [[ -f .device-pkgs/ref.tar.xz ]]; then
   ref=$(mktemp -d) && tar -C "$ref" -xJf .device-pkgs/ref.tar.xz && ref=$ref/bin/voxbreast
 fi
 
-VOXBREAST_DEVICE=gpu run test_physics --gtest_filter='*VolumeKernels*:VolumeConstraint.*:*KernelForces*:*KernelSteps*:HyperelasticKernels.*:*Uniaxial*:*SimpleShear*:*Tension*:*PlateCompression*' \
+VOXBREAST_DEVICE=gpu run test_physics --gtest_filter='*VolumeKernels*:VolumeConstraint.*:*KernelForces*:*KernelSteps*:HyperelasticKernels.*:*Uniaxial*:*SimpleShear*:*Tension*:*PlateCompression*:*BiphasicKernels*:*RestOffsets*:*TorusContact*:*Relaxation*' \
   2>&1 | grep -E '^\[ *(OK|FAILED|PASSED) *\]|Failure|pending vs' | tee "$out/gpu_tests.txt"
 # the split force passes (four work-items per element, any law) against the host
 VOXBREAST_DEVICE=gpu VOXBREAST_FORCE_SPLIT=4 run test_physics --gtest_filter='*KernelSteps*:HyperelasticKernels.MatchHost*' \

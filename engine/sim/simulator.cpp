@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 
 #include "engine/device/torus.hpp"
 #include "engine/error.hpp"
@@ -26,8 +27,9 @@ constexpr int kCheckBaseSlots = 5, kCheckSlotsPerIndenter = 4;  // kernels/check
 constexpr int kCheckSlotsPerTorus = 8;                             // VB_TORUS_SLOTS
 constexpr int kIndenterStride = 20;                                // VB_IND_STRIDE
 constexpr int kTorusStride = 12;                                   // VB_TORUS_STRIDE
-// Kernel argument layout (kernels/common.cl): VB_LATTICE_PARAMS then VB_INDENTER_PARAMS.
-constexpr int kLatticeArgs = 16, kIndenterArgs = 3;
+// Kernel argument layout (kernels/common.cl): VB_LATTICE_KERNEL_PARAMS (the arena, its offsets,
+// then the scalars; gravity 7th) then VB_INDENTER_PARAMS.
+constexpr int kLatticeArgs = 10, kLatticeGravity = 6, kIndenterArgs = 3;
 constexpr int kStepLattice = 4;                              // step kernels: 4 state buffers first
 constexpr int kStepIndenter = kStepLattice + kLatticeArgs;   // then dt, n
 constexpr int kCheckLattice = 2;                             // check_state: u, v first
@@ -38,12 +40,12 @@ constexpr int kTriangleArgs = 4;
 constexpr int kCheckVolume = kCheckIndenter + kIndenterArgs + 3;  // VB_VOLUME: grad, scalars
 // kernels/volume.cl: volume_partials takes u, v, the lattice parameters, then these.
 constexpr int kVolumeSlots = 5, kVolumeScalars = 4;
-constexpr int kVolumeMesh = 2 + kLatticeArgs;  // triangles, n_tri, surface, start, incident, n_surf
-constexpr int kVolumeCentre = kVolumeMesh + 6, kVolumeWithForce = kVolumeMesh + 8;
+constexpr int kVolumeMesh = 2 + kLatticeArgs;  // mesh arena, its offsets, n_tri, n_surf
+constexpr int kVolumeCentre = kVolumeMesh + 4, kVolumeWithForce = kVolumeMesh + 6;
 // volume_project: u, v, the lattice parameters, the mesh, centre, then grad, partial, V0, scalars, count
 constexpr int kProjectGrad = kVolumeCentre + 1, kProjectRestVolume = kVolumeCentre + 3;
-// volume_apply: u, v, surface, n_surface, grad, partial, groups, V0, scalars
-constexpr int kApplyRestVolume = 7;
+// volume_apply: u, v, mesh arena, its offsets, n_surface, grad, partial, groups, V0, scalars
+constexpr int kApplyRestVolume = 8;
 
 template <typename T>
 std::vector<T> pack4(const std::vector<double>& xyz, const std::vector<double>* w) {
@@ -165,21 +167,17 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     grid[cell_of[e]] = cl_int(e);
   }
 
-  const auto flags_ro = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
-  grid_ = cl::Buffer(cl.context, flags_ro, cells * sizeof(cl_int), grid.data());
-  cell_ = cl::Buffer(cl.context, flags_ro, n_ * sizeof(cl_uint), cell_of.data());
-  E_ = make_real_buffer(el.youngs_modulus_pa);
-  for (cl::Buffer* b : {&u_, &v_, &u_tmp_, &v_tmp_}) *b = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
-  upload(el.displacement_m, std::vector<double>(3 * n_, 0.0));
-  make_hyperelastic_buffers(el);
   // The unloaded reference state: rest offsets (zero until set_rest_offsets), and for
   // hyperelastic tissue the rest frame R₀, J₀ (kernels/hyperelastic.cl); placeholders otherwise.
   rest_offsets_ = scene.reference_state.active;
+  hyper_ = el.hyperelastic;
   const std::size_t offset_bytes = (rest_offsets_ ? n_ : 1) * 4 * real_size_;
   const std::size_t frame_bytes = (rest_offsets_ && hyper_ ? 3 * n_ : 1) * 4 * real_size_;
   if (rest_offsets_) device_bytes_ += offset_bytes + (hyper_ ? frame_bytes : 0);
-  std::vector<char> blank(std::max(offset_bytes, frame_bytes), 0);
-  rest_offset_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, offset_bytes, blank.data());
+  make_model_arena(el, grid, cell_of, offset_bytes);
+  for (cl::Buffer* b : {&u_, &v_, &u_tmp_, &v_tmp_}) *b = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
+  upload(el.displacement_m, std::vector<double>(3 * n_, 0.0));
+  std::vector<char> blank(frame_bytes, 0);
   rest_frame_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, frame_bytes, blank.data());
 
   const std::size_t wg = kCheckWorkGroup;
@@ -276,6 +274,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_TORUS_BASE=" + std::to_string(torus_table_base());
   options += " -DVB_FRICTION=" + std::to_string(friction);
   options += " -DVB_REST_OFFSET=" + std::to_string(rest_offsets_);
+  options += " -DVB_ARENA_UNIT=" + std::to_string(DeviceArena::kUnit);
   options += " -DVB_TRI_CONTACT=" + std::to_string(tri_contact_);
   // the penalty geometry in double where the device has it (kernels/triangle_contact.cl)
   options += " -DVB_TRI_FP64=" + std::to_string(tri_contact_ && cl_.info.fp64);
@@ -289,10 +288,8 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   if (hyper_) {
     stress_ = cl::Kernel(program_, "element_stress");
     set_element_fit_args(stress_);
-    stress_.setArg(8, Q_);
-    stress_.setArg(9, C_);
-    stress_.setArg(10, cl_uint(n_));
-    stress_.setArg(11, rest_frame_);
+    stress_.setArg(6, cl_uint(n_));
+    stress_.setArg(7, rest_frame_);
   }
 
   const bool heun = scene.solver.integrator == Integrator::Heun;
@@ -351,8 +348,8 @@ void Simulator::set_rest_offsets(const std::vector<double>& u0) {
     cl::Kernel k(program_, "rest_frame");
     k.setArg(0, rest_offset_);
     set_element_fit_args(k);
-    k.setArg(8, rest_frame_);
-    k.setArg(9, cl_uint(n_));
+    k.setArg(6, rest_frame_);
+    k.setArg(7, cl_uint(n_));
     enqueue(k);
   }
   if (relax_) {  // the Rayleigh quotients' previous state: the rest state, where the force is zero
@@ -419,11 +416,13 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   for (const cl_uint e : surface) centre += lattice_.rest_position(e);
   centre /= double(surface.size());
 
-  const auto flags_ro = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
-  vol_triangles_ = cl::Buffer(cl_.context, flags_ro, triangles.size() * sizeof(cl_uint), triangles.data());
-  vol_surface_ = cl::Buffer(cl_.context, flags_ro, surface.size() * sizeof(cl_uint), surface.data());
-  vol_incident_start_ = cl::Buffer(cl_.context, flags_ro, start.size() * sizeof(cl_uint), start.data());
-  vol_incident_ = cl::Buffer(cl_.context, flags_ro, incident.size() * sizeof(cl_uint), incident.data());
+  // one buffer for the mesh (device_arena.hpp), slots as kernels/volume.cl's VB_UNPACK_MESH
+  vol_mesh_.add(triangles.data(), triangles.size() * sizeof(cl_uint));
+  vol_mesh_.add(surface.data(), surface.size() * sizeof(cl_uint));
+  vol_mesh_.add(start.data(), start.size() * sizeof(cl_uint));
+  vol_mesh_.add(incident.data(), incident.size() * sizeof(cl_uint));
+  vol_mesh_.create(cl_);
+  for (int i = 0; i < 4; ++i) vol_mesh_at_.s[i] = vol_mesh_.offset_units(std::size_t(i));
   std::vector<char> zeros(4 * real_size_ * n_, 0);  // gradient: zero off the surface
   vol_grad_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, zeros.size(), zeros.data());
   vol_partial_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, volume_groups_ * kVolumeSlots * real_size_);
@@ -437,12 +436,10 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   const auto mesh_kernel = [&](const char* name) {
     cl::Kernel k(program_, name);
     set_lattice_args(k, 2);
-    k.setArg(kVolumeMesh + 0, vol_triangles_);
-    k.setArg(kVolumeMesh + 1, cl_uint(volume_triangles_));
-    k.setArg(kVolumeMesh + 2, vol_surface_);
-    k.setArg(kVolumeMesh + 3, vol_incident_start_);
-    k.setArg(kVolumeMesh + 4, vol_incident_);
-    k.setArg(kVolumeMesh + 5, cl_uint(volume_surface_));
+    k.setArg(kVolumeMesh + 0, vol_mesh_.buffer());
+    k.setArg(kVolumeMesh + 1, vol_mesh_at_);
+    k.setArg(kVolumeMesh + 2, cl_uint(volume_triangles_));
+    k.setArg(kVolumeMesh + 3, cl_uint(volume_surface_));
     set_world_vector(k, kVolumeCentre, centre);
     k.setArg(kVolumeCentre + 1, vol_grad_);
     return k;
@@ -454,11 +451,12 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   vol_finish_.setArg(1, cl_uint(volume_groups_));
   vol_finish_.setArg(3, vol_scalars_);
   vol_apply_ = cl::Kernel(program_, "volume_apply");
-  vol_apply_.setArg(2, vol_surface_);
-  vol_apply_.setArg(3, cl_uint(volume_surface_));
-  vol_apply_.setArg(4, vol_grad_);
-  vol_apply_.setArg(5, vol_partial_);
-  vol_apply_.setArg(6, cl_uint(volume_groups_));
+  vol_apply_.setArg(2, vol_mesh_.buffer());
+  vol_apply_.setArg(3, vol_mesh_at_);
+  vol_apply_.setArg(4, cl_uint(volume_surface_));
+  vol_apply_.setArg(5, vol_grad_);
+  vol_apply_.setArg(6, vol_partial_);
+  vol_apply_.setArg(7, cl_uint(volume_groups_));
   vol_apply_.setArg(kApplyRestVolume + 1, vol_scalars_);
   vol_project_ = mesh_kernel("volume_project");
   vol_project_.setArg(kProjectGrad + 1, vol_partial_);
@@ -581,35 +579,57 @@ std::vector<double> Simulator::volume_gradient_m2() {
   return g;
 }
 
-void Simulator::make_hyperelastic_buffers(const ElementArrays& el) {
-  // Only scenes with hyperelastic tissues get real buffers; others get 1-element placeholders.
-  // Biphasic springs need the tissue ids and the material table too (not F and Q).
-  hyper_ = el.hyperelastic;
+void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_int>& grid,
+                                 const std::vector<cl_uint>& cell_of, std::size_t offset_bytes) {
+  // One buffer for the arrays every stepping kernel reads (device_arena.hpp: each buffer argument
+  // costs host time per launch on NVIDIA); slots in kernels/common.cl's order (VB_UNPACK_LATTICE).
+  // Spring-only scenes get 1-element placeholders for the hyperelastic arrays; biphasic springs
+  // need the tissue ids and the material table too (not Q and C).
   const bool per_tissue = hyper_ || el.biphasic;
-  const auto flags_ro = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
   std::vector<cl_uchar> tissue(per_tissue ? n_ : 1, 0);
   if (per_tissue) std::copy(lattice_.tissue_of_element.begin(), lattice_.tissue_of_element.end(), tissue.begin());
-  tissue_ = cl::Buffer(cl_.context, flags_ro, tissue.size(), tissue.data());
   std::vector<double> table;
   for (const auto& row : el.material_table) table.insert(table.end(), row.begin(), row.end());
   if (!per_tissue) table.assign(12, 0.0);
-  materials_ = make_real_buffer(table);
+  const std::vector<unsigned char> E = real_bytes(el.youngs_modulus_pa), materials = real_bytes(table);
   // kernels/hyperelastic.cl, hyper_store: Q's 3 rows (C = FᵀF's diagonal in w), C's other entries
   const std::size_t row_bytes = (hyper_ ? n_ : 1) * 4 * real_size_;
-  Q_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, 3 * row_bytes);
-  C_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, row_bytes);
+  const std::size_t slot[8] = {
+      arena_.add(E.data(), E.size()),
+      arena_.add(cell_of.data(), cell_of.size() * sizeof(cl_uint)),
+      arena_.add(grid.data(), grid.size() * sizeof(cl_int)),
+      arena_.add(tissue.data(), tissue.size()),
+      arena_.add(materials.data(), materials.size()),
+      arena_.add(nullptr, 3 * row_bytes),
+      arena_.add(nullptr, row_bytes),
+      arena_.add(nullptr, offset_bytes)};  // rest offsets: zero until set_rest_offsets
+  require(arena_.bytes() <= cl_.info.max_allocation_bytes,
+          "the model's arrays need one buffer of " + mib(double(arena_.bytes())) + " but '" + cl_.info.name +
+              "' allocates at most " + mib(double(cl_.info.max_allocation_bytes)),
+          "model", "downsample or crop the model");
+  arena_.create(cl_);
+  for (int i = 0; i < 8; ++i) arena_at_.s[i] = arena_.offset_units(slot[i]);
+  E_ = arena_.part(slot[0]);
+  cell_ = arena_.part(slot[1]);
+  rest_offset_ = arena_.part(slot[7]);
+}
+
+std::vector<unsigned char> Simulator::real_bytes(const std::vector<double>& values) const {
+  std::vector<unsigned char> out(values.size() * real_size_);
+  if (precision_ == Precision::Double) {
+    std::memcpy(out.data(), values.data(), out.size());
+    return out;
+  }
+  for (std::size_t i = 0; i < values.size(); ++i) {  // "never" (1e300) saturates within float range
+    const float f = float(std::clamp(values[i], -3e38, 3e38));
+    std::memcpy(out.data() + i * sizeof f, &f, sizeof f);
+  }
+  return out;
 }
 
 cl::Buffer Simulator::make_real_buffer(const std::vector<double>& values) const {
-  const auto flags = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
-  if (precision_ == Precision::Double) {
-    std::vector<double> data(values);  // the API wants a mutable pointer
-    return cl::Buffer(cl_.context, flags, data.size() * sizeof(double), data.data());
-  }
-  std::vector<float> data(values.size());
-  for (std::size_t i = 0; i < values.size(); ++i)  // "never" (1e300) saturates within float range
-    data[i] = float(std::clamp(values[i], -3e38, 3e38));
-  return cl::Buffer(cl_.context, flags, data.size() * sizeof(float), data.data());
+  std::vector<unsigned char> data = real_bytes(values);
+  return cl::Buffer(cl_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, data.size(), data.data());
 }
 
 namespace {
@@ -633,32 +653,24 @@ void Simulator::set_world_vector(cl::Kernel& k, int index, const Vec3& world) co
 
 void Simulator::set_element_fit_args(cl::Kernel& k) {
   // kernels/hyperelastic.cl: element_stress and rest_frame take these after the displacements
-  k.setArg(1, tissue_);
-  k.setArg(2, materials_);
-  k.setArg(3, cell_);
-  k.setArg(4, grid_);
-  k.setArg(5, cl_int(stride_y_));
-  k.setArg(6, cl_int(stride_z_));
-  set_real(k, 7, lattice_.spacing_m);
+  k.setArg(1, arena_.buffer());
+  k.setArg(2, arena_at_);
+  k.setArg(3, cl_int(stride_y_));
+  k.setArg(4, cl_int(stride_z_));
+  set_real(k, 5, lattice_.spacing_m);
 }
 
 void Simulator::set_lattice_args(cl::Kernel& k, int a) {
-  k.setArg(a + 0, E_);
-  k.setArg(a + 1, cell_);
-  k.setArg(a + 2, grid_);
-  k.setArg(a + 3, cl_int(stride_y_));
-  k.setArg(a + 4, cl_int(stride_z_));
-  set_real(k, a + 5, lattice_.spacing_m);
-  set_real(k, a + 6, scene_.solver.dashpot_ratio);
-  set_world_vector(k, a + 7, gravity_);
-  set_real(k, a + 8, damping_);
-  set_world_vector(k, a + 9, lattice_.origin_m);
-  k.setArg(a + 10, tissue_);
-  k.setArg(a + 11, materials_);
-  k.setArg(a + 12, Q_);
-  k.setArg(a + 13, C_);
-  set_real(k, a + 14, scene_.solver.hourglass);
-  k.setArg(a + 15, rest_offset_);
+  k.setArg(a + 0, arena_.buffer());
+  k.setArg(a + 1, arena_at_);
+  k.setArg(a + 2, cl_int(stride_y_));
+  k.setArg(a + 3, cl_int(stride_z_));
+  set_real(k, a + 4, lattice_.spacing_m);
+  set_real(k, a + 5, scene_.solver.dashpot_ratio);
+  set_world_vector(k, a + kLatticeGravity, gravity_);
+  set_real(k, a + 7, damping_);
+  set_world_vector(k, a + 8, lattice_.origin_m);
+  set_real(k, a + 9, scene_.solver.hourglass);
 }
 
 Vec3 Simulator::indenter_position(std::size_t i, double t) const {
@@ -793,8 +805,8 @@ void Simulator::enqueue_stress(const cl::Buffer& u, const cl::Buffer* pending_gr
   if (!hyper_) return;
   stress_.setArg(0, u);
   if (volume_launches_ == 0) {  // element_stress's pending projection (VB_VOLUME_FOLD)
-    stress_.setArg(12, pending_grad ? *pending_grad : vol_grad_);
-    stress_.setArg(13, pending_scalars ? *pending_scalars : vol_no_scalars_);
+    stress_.setArg(8, pending_grad ? *pending_grad : vol_grad_);
+    stress_.setArg(9, pending_scalars ? *pending_scalars : vol_no_scalars_);
   }
   enqueue(stress_);
 }
@@ -934,12 +946,12 @@ void Simulator::set_gravity(const Vec3& g) {
   require(scene_.gravity.active, "gravity can change only in a scene with a [gravity] section", "gravity");
   gravity_ = g;
   for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_})
-    if ((*k)()) set_world_vector(*k, kStepLattice + 7, g);
-  set_world_vector(check_, kCheckLattice + 7, g);
+    if ((*k)()) set_world_vector(*k, kStepLattice + kLatticeGravity, g);
+  set_world_vector(check_, kCheckLattice + kLatticeGravity, g);
   if (volume_) {
-    set_world_vector(vol_partials_, 2 + 7, g);
-    set_world_vector(vol_project_, 2 + 7, g);
-    if (volume_launches_ == 0) set_world_vector(vol_pending_, 2 + 7, g);
+    set_world_vector(vol_partials_, 2 + kLatticeGravity, g);
+    set_world_vector(vol_project_, 2 + kLatticeGravity, g);
+    if (volume_launches_ == 0) set_world_vector(vol_pending_, 2 + kLatticeGravity, g);
   }
 }
 

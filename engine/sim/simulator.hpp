@@ -12,6 +12,7 @@
 
 #include "engine/lattice/lattice.hpp"
 #include "engine/scene/scene.hpp"
+#include "engine/sim/device_arena.hpp"
 #include "engine/sim/element_setup.hpp"
 #include "engine/sim/opencl_runtime.hpp"
 #include "engine/sim/time_step.hpp"
@@ -179,7 +180,9 @@ class Simulator {
   /// scalars; none when null)
   void enqueue_stress(const cl::Buffer& u, const cl::Buffer* pending_grad = nullptr,
                       const cl::Buffer* pending_scalars = nullptr);
-  void make_hyperelastic_buffers(const ElementArrays& el);
+  void make_model_arena(const ElementArrays& el, const std::vector<cl_int>& grid, const std::vector<cl_uint>& cell_of,
+                        std::size_t offset_bytes);
+  std::vector<unsigned char> real_bytes(const std::vector<double>& values) const;  ///< in the model's precision
   /// The rigid-obstacle table the kernels read (lattice frame): indenter rows (a placeholder row if
   /// none), then torus rows and their inflation knots (kernels/device_contact.cl).
   std::vector<double> obstacle_table() const;
@@ -203,9 +206,13 @@ class Simulator {
   cl::NDRange global_, local_;
   std::size_t check_groups_ = 0;
 
-  cl::Buffer u_, v_, u_tmp_, v_tmp_, E_, cell_, grid_, partial_, partial_arg_;
+  cl::Buffer u_, v_, u_tmp_, v_tmp_, partial_, partial_arg_;
+  /// E, cell_of, grid, tissue ids, material table, Q, C, rest offsets (kernels/common.cl,
+  /// VB_UNPACK_LATTICE) and their offsets; E_, cell_, rest_offset_ are the host's views of three.
+  DeviceArena arena_;
+  cl_uint8 arena_at_{};
+  cl::Buffer E_, cell_;
   bool hyper_ = false;
-  cl::Buffer tissue_, materials_, Q_, C_;
   cl::Buffer indenters_;  ///< rigid-obstacle table: indenters and tori (lattice frame)
   std::vector<IndenterMotion> motion_;  ///< per indenter, what its row holds now
   std::vector<std::size_t> path_segment_;  ///< per indenter with a trajectory: the segment its row holds
@@ -247,9 +254,9 @@ class Simulator {
   /// applies the state's pending projection (volume_apply) before anything else reads u, v
   void apply_pending_projection() const;
   bool volume_pairs_ = true;  ///< incident triangles as element pairs (VB_VOLUME_PAIRS)
-  mutable bool pending_ = false;
+  mutable bool pending_ = false;  ///< (u_, v_) has a projection pending (vol_grad_, vol_scalars_)
   int force_split_ = 1;
-  cl::NDRange step_global_, step_local_;  ///< Heun's stepping kernels (VB_SPLIT)  ///< (u_, v_) has a projection pending (vol_grad_, vol_scalars_)
+  cl::NDRange step_global_, step_local_;  ///< Heun's stepping kernels (VB_SPLIT)
   cl::Buffer vol_grad_pred_, vol_scalars_pred_, vol_no_scalars_;
   cl::Kernel vol_pending_;
   bool volume_ = false;
@@ -258,7 +265,9 @@ class Simulator {
   std::size_t volume_triangles_ = 0, volume_surface_ = 0, volume_groups_ = 0;
   std::size_t volume_wg_ = 0;   ///< work-group size of volume_project (VB_VOLUME_WG)
   int volume_launches_ = 1;     ///< per projection: 1 volume_project, 2 volume_partials + volume_apply, 0 folded
-  cl::Buffer vol_triangles_, vol_surface_, vol_incident_start_, vol_incident_, vol_grad_, vol_partial_,
+  DeviceArena vol_mesh_;  ///< triangles, surface elements, incident start, incident (kernels/volume.cl)
+  cl_uint4 vol_mesh_at_{};
+  cl::Buffer vol_grad_, vol_partial_,
       vol_scalars_, vol_done_;
   cl::Kernel vol_partials_, vol_finish_, vol_project_;
   mutable cl::Kernel vol_apply_;
