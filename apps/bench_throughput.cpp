@@ -141,12 +141,15 @@ void print_launch_floor(const ClContext& cl) {
 /// (neighbour reads are served from cache): stage 1 reads u, v, E, cell, grid and writes ũ, ṽ;
 /// stage 2 reads u, v, ũ, ṽ, E, cell, grid and writes u, v. Hyperelastic tissues add, per
 /// stage, the stress pass (reads u, cell, grid, tissue; writes Q and C: 4 vectors) and the
-/// gather's read of the element's own Q and C and tissue.
-double heun_bytes_per_element(std::size_t real_size, bool hyperelastic) {
+/// gather's read of the element's own Q and C and tissue. Biphasic springs add the element's own
+/// tissue id per stage (the neighbours' ids and material rows are neighbour reads).
+double heun_bytes_per_element(std::size_t real_size, const std::string& law) {
   const double vec = 4.0 * double(real_size), scalar = double(real_size), idx = 4.0;
   const double springs = (2 * vec + scalar + 2 * idx + 2 * vec) + (4 * vec + scalar + 2 * idx + 2 * vec);
   const double stress_pass = (vec + 2 * idx + 1 + 4 * vec) + (4 * vec + 1);
-  return springs + (hyperelastic ? 2 * stress_pass : 0.0);
+  if (law == "linear") return springs;
+  if (law == "biphasic") return springs + 2 * 1.0;
+  return springs + 2 * stress_pass;
 }
 
 /// Device time per kernel over about 0.2 s of steps of the same model on a profiling queue. On
@@ -215,8 +218,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     const std::size_t n = lattice.element_count();
     const std::size_t real_size = c.precision == Precision::Double ? 8 : 4;
     const bool heun = c.integrator == Integrator::Heun;
-    const bool hyper = c.law != "linear";
-    const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, hyper);
+    const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, c.law);
     const double effective = bytes * double(n) * sps;
     const char* integ = heun ? "heun" : "symplectic_euler";
     const char* prec = c.precision == Precision::Double ? "double" : "float";

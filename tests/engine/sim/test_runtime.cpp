@@ -1,12 +1,50 @@
 #include <gtest/gtest.h>
 
+#include <cstring>
+#include <vector>
+
 #include "engine/error.hpp"
+#include "engine/sim/device_arena.hpp"
 #include "engine/sim/opencl_runtime.hpp"
 #include "engine/sim/simulator.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
 
 namespace vb {
 namespace {
+
+// The arena's arrays land at aligned offsets in one buffer, each sub-buffer sees its own array
+// (copied or zero), and a write through a sub-buffer is what the whole buffer holds there.
+TEST(DeviceArena, KeepsEachArrayAtItsOffsetAndSubBuffersViewThem) {
+  const ClContext& cl = test::cl_context();
+  DeviceArena arena;
+  const std::vector<cl_int> ints = {1, -2, 3, -4, 5};
+  const std::vector<cl_uchar> bytes(4097, 7);  // crosses a 4 KiB unit
+  const std::size_t a = arena.add(ints.data(), ints.size() * sizeof(cl_int));
+  const std::size_t b = arena.add(nullptr, 3 * sizeof(cl_float));
+  const std::size_t c = arena.add(bytes.data(), bytes.size());
+  arena.create(cl);
+  EXPECT_EQ(arena.offset_units(a), 0u);
+  EXPECT_EQ(arena.offset_units(b), 1u);
+  EXPECT_EQ(arena.offset_units(c), 2u);
+  EXPECT_EQ(arena.bytes(), 2 * DeviceArena::kUnit + bytes.size());
+
+  std::vector<cl_int> read_ints(ints.size());
+  cl.queue.enqueueReadBuffer(arena.part(a), CL_TRUE, 0, read_ints.size() * sizeof(cl_int), read_ints.data());
+  EXPECT_EQ(read_ints, ints);
+  std::vector<cl_float> zeros(3, 1.0f);
+  cl.queue.enqueueReadBuffer(arena.part(b), CL_TRUE, 0, zeros.size() * sizeof(cl_float), zeros.data());
+  EXPECT_EQ(zeros, std::vector<cl_float>(3, 0.0f));
+
+  const std::vector<cl_float> written = {0.5f, -1.5f, 2.5f};
+  cl.queue.enqueueWriteBuffer(arena.part(b), CL_TRUE, 0, written.size() * sizeof(cl_float), written.data());
+  std::vector<unsigned char> whole(arena.bytes());
+  cl.queue.enqueueReadBuffer(arena.buffer(), CL_TRUE, 0, whole.size(), whole.data());
+  std::vector<cl_float> at_b(3);
+  std::memcpy(at_b.data(), whole.data() + DeviceArena::kUnit, at_b.size() * sizeof(cl_float));
+  EXPECT_EQ(at_b, written);
+  EXPECT_EQ(whole[2 * DeviceArena::kUnit + 4096], 7);
+  EXPECT_THROW(arena.add(nullptr, 4), Error);  // no arrays after create()
+}
 
 TEST(OpenCLRuntime, ListsAtLeastOneDevice) {
   const auto devices = list_devices();
