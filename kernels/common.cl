@@ -15,6 +15,7 @@
 //   -DVB_VOLUME_FOLD=0|1  Heun with the volume constraint, projections applied by the kernels that
 //                     read the state next (VB_PENDING_PARAMS below) instead of by volume_apply
 //   -DVB_VOLUME_PAIRS=0|1  the volume gradient's incident triangles as element pairs (kernels/volume.cl)
+//   -DVB_ARENA_UNIT=N  the unit of the arena offsets (bytes, engine/sim/device_arena.hpp)
 // and prepends the lattice tables (VB_DIR, VB_DIR_LEN, VB_KAPPA) generated from the host's
 // single definition (engine/sim/kernel_tables.cpp).
 #if VB_DOUBLE
@@ -45,7 +46,9 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
 // An element within this fraction of a spacing of the indenter surface is in contact.
 #define REAL_CONTACT_TOL ((real)1e-3)
 
-// Parameters every stepping kernel takes, in this order (the host sets them in one place).
+// Parameters of the force and stepping helpers, in this order; kernels take
+// VB_LATTICE_KERNEL_PARAMS (below, set by the host in one place) and name these with
+// VB_UNPACK_LATTICE.
 // Hyperelastic data (tissue_of, materials, Qs, Cs, hourglass) are 1-element placeholders when
 // VB_HYPER is 0; tissue_of and materials are real when VB_BIPHASIC is 1; rest_offset (m, lattice
 // frame) is a placeholder when VB_REST_OFFSET is 0.
@@ -58,7 +61,7 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
   E, cell_of, grid, sy, sz, h, dashpot_ratio, gravity, damping, origin, tissue_of, materials, Qs, Cs, hourglass, \
       rest_offset
 // What kernels take instead: the model's arrays in one buffer, the arena (engine/sim/device_arena.hpp:
-// NVIDIA's OpenCL spends ~0.35 µs of host time per buffer argument of every launch), with each
+// NVIDIA's OpenCL spends ~0.4 µs of host time per buffer argument of every launch), with each
 // array's offset in units of VB_ARENA_UNIT bytes in `at`: E, cell_of, grid, tissue_of, materials,
 // Q rows, C, rest offsets. VB_UNPACK_LATTICE at the top of a kernel names them as above.
 #define VB_ARENA_AT(arena, slot) ((arena) + (size_t)(slot) * VB_ARENA_UNIT)
