@@ -16,6 +16,8 @@
 //                     read the state next (VB_PENDING_PARAMS below) instead of by volume_apply
 //   -DVB_VOLUME_PAIRS=0|1  the volume gradient's incident triangles as element pairs (kernels/volume.cl)
 //   -DVB_ARENA_UNIT=N  the unit of the arena offsets (bytes, engine/sim/device_arena.hpp)
+//   -DVB_NV_PTX=0|1   NVIDIA device: inline PTX for device-scope fences (vb_device_fence)
+//   -DVB_PERSISTENT=0|1  Heun's whole step in one launch (kernels/persistent.cl, NVIDIA only)
 // and prepends the lattice tables (VB_DIR, VB_DIR_LEN, VB_KAPPA) generated from the host's
 // single definition (engine/sim/kernel_tables.cpp).
 #if VB_DOUBLE
@@ -26,6 +28,18 @@ typedef double4 real4;
 typedef float real;
 typedef float4 real4;
 #endif
+
+// A fence at device scope: the writes before it are visible to every work-group that sees a later
+// atomic. OpenCL 1.2's mem_fence(CLK_GLOBAL_MEM_FENCE) is only a work-group fence on NVIDIA (PTX
+// membar.cta, seen in the PTX), so there the host passes -DVB_NV_PTX=1 and the fence is PTX's
+// membar.gl (CUDA's __threadfence), which also makes this SM's later loads miss stale L1 lines.
+inline void vb_device_fence(void) {
+#if VB_NV_PTX
+  asm volatile("membar.gl;" ::: "memory");
+#else
+  mem_fence(CLK_GLOBAL_MEM_FENCE);
+#endif
+}
 
 inline real4 xyz0(real4 a) { return (real4)(a.x, a.y, a.z, 0); }
 inline real dot3(real4 a, real4 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }

@@ -323,30 +323,20 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
 // F₀ (rest_frame: rows of R₀ = F₀⁻¹, J₀ = det F₀ in row 0's w): the law sees F·R₀ and the energy
 // J₀·V·W(F·R₀) gives Q = J₀·V·P(F·R₀)·R₀ᵀ·B⁻¹ on the same lattice offsets. C_out is that of the
 // deformation from rest (F·R₀), which the hourglass control applies to the rest connections.
-// With VB_VOLUME_FOLD, u may have a volume projection pending: its gradient pend_g and scalars
-// {λ, μ, …} (all zero when none is).
-kernel void element_stress(global const real4* u, global uchar* arena, uint8 at, int sy, int sz, real h, uint n,
-                           global const real4* rest_frame
-#if VB_VOLUME_FOLD
-                           , global const real4* pend_g, global const real* pend_scalars
-#endif
-) {
+// u may have a volume projection pending (VB_PENDING_PARAMS: VB_VOLUME_FOLD's element_stress).
+// element_stress_one is element e's share, for element_stress below and for the persistent Heun
+// step (kernels/persistent.cl).
+inline void element_stress_one(uint e, global const real4* u, global uchar* arena, uint8 at, int sy, int sz, real h,
+                               global const real4* rest_frame, VB_PENDING_PARAMS) {
   VB_UNPACK_FIT;
   global real4* Q_out = (global real4*)VB_ARENA_AT(arena, at.s5);  // written here (hyper_store)
   global real4* C_out = (global real4*)VB_ARENA_AT(arena, at.s6);
-  const uint e = get_global_id(0);
-  if (e >= n) return;
-#if VB_VOLUME_FOLD
-#define VB_STRESS_PENDING pend_g, pend_scalars[0], (real)0, 1
-#else
-#define VB_STRESS_PENDING VB_NO_PENDING
-#endif
   global const real* mat = materials + VB_MAT_STRIDE * tissue_of[e];
   const int law = (int)mat[0];
   mat3 F, Bi;
   uint present = 0;
   // spring tissue, or neighbours that do not span 3-D: no element stress
-  if (!VB_LAW_HYPER(law) || !fit_gradient(u, e, cell_of, grid, sy, sz, h, &F, &Bi, &present, VB_STRESS_PENDING)) {
+  if (!VB_LAW_HYPER(law) || !fit_gradient(u, e, cell_of, grid, sy, sz, h, &F, &Bi, &present, VB_PENDING_ARGS)) {
     hyper_store(Q_out, C_out, e, mat3_zero(), mat3_identity(), VB_LAW_HYPER(law));
     return;
   }
@@ -376,6 +366,23 @@ kernel void element_stress(global const real4* u, global uchar* arena, uint8 at,
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) Q.m[a][b] *= wh;
   hyper_store(Q_out, C_out, e, Q, C, 1);
+}
+
+// With VB_VOLUME_FOLD, u may have a volume projection pending: its gradient pend_g and scalars
+// {λ, μ, …} (all zero when none is).
+kernel void element_stress(global const real4* u, global uchar* arena, uint8 at, int sy, int sz, real h, uint n,
+                           global const real4* rest_frame
+#if VB_VOLUME_FOLD
+                           , global const real4* pend_g, global const real* pend_scalars
+#endif
+) {
+  const uint e = get_global_id(0);
+  if (e >= n) return;
+#if VB_VOLUME_FOLD
+  element_stress_one(e, u, arena, at, sy, sz, h, rest_frame, pend_g, pend_scalars[0], (real)0, 1);
+#else
+  element_stress_one(e, u, arena, at, sy, sz, h, rest_frame, VB_NO_PENDING);
+#endif
 }
 
 #if VB_REST_OFFSET

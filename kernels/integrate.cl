@@ -95,7 +95,7 @@ inline real4 correct_update(uint e, real4* ui, real4 vi, real4 up, real4 vp, rea
 #define VB_SPLIT_WG 128
 #define VB_SPLIT_PER (VB_SPLIT_WG / VB_SPLIT)
 #define VB_STEP_ATTR __attribute__((reqd_work_group_size(VB_SPLIT_WG, 1, 1)))
-inline uint split_element(void) { return get_group_id(0) * VB_SPLIT_PER + get_local_id(0) % VB_SPLIT_PER; }
+inline uint split_element(uint block) { return block * VB_SPLIT_PER + get_local_id(0) % VB_SPLIT_PER; }
 
 // The lattice force on e summed over the parts (in part 0; every work-item of the group must call).
 inline real4 split_lattice_force(int active, uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
@@ -119,10 +119,9 @@ inline real4 split_lattice_force(int active, uint e, real4 ui, real4 vi, global 
 // Heun's predictor (explicit Euler) moves with the old v. `symplectic` is a constant at each call.
 // (u, v) may have a volume projection pending (kernels/common.cl): the stage starts from the
 // projected state, its own included.
-inline void explicit_stage(global const real4* u, global const real4* v, global real4* u_out,
+inline void explicit_stage(uint e, global const real4* u, global const real4* v, global real4* u_out,
                            global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
                            uint n, int symplectic, VB_PENDING_PARAMS VB_TRI_PARAMS) {
-  const uint e = get_global_id(0);
   if (e >= n) return;
   real4 ui = u[e], vi = v[e], wg = (real4)(0);
   pending_u(&ui, &wg, e, VB_PENDING_ARGS);
@@ -139,7 +138,7 @@ kernel void euler_step(global const real4* u, global const real4* v, global real
                        global real4* v_out, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
                        uint n VB_TRI_PARAMS) {
   VB_UNPACK_LATTICE;
-  explicit_stage(u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1, VB_NO_PENDING VB_TRI_ARGS);
+  explicit_stage(get_global_id(0), u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1, VB_NO_PENDING VB_TRI_ARGS);
 }
 
 // With VB_VOLUME_FOLD (Heun with the volume constraint, kernels/volume.cl: volume_pending) the
@@ -154,42 +153,38 @@ kernel void euler_step(global const real4* u, global const real4* v, global real
 #define VB_FOLD_PENDING(name) VB_NO_PENDING
 #endif
 
-kernel VB_STEP_ATTR void heun_predict(global const real4* u, global const real4* v, global real4* u_pred,
-                                      global real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
-                                      uint n VB_FOLD_PARAMS(state) VB_TRI_PARAMS) {
-  VB_UNPACK_LATTICE;
+// Heun's predictor for element e (ũ, ṽ into u_pred, v_pred). With VB_SPLIT > 1 every work-item of
+// the group calls it, e = split_element(block), and `share` holds VB_SPLIT_WG real4.
+inline void predict_element(uint e, global const real4* u, global const real4* v, global real4* u_pred,
+                            global real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt, uint n,
+                            VB_PENDING_PARAMS, local real4* share VB_TRI_PARAMS) {
 #if VB_SPLIT > 1
-  local real4 share[VB_SPLIT_WG];
-  const uint e = split_element();
   const int in = e < n;
   real4 ui = (real4)(0), vi = (real4)(0), wg = (real4)(0);
   if (in) {
     ui = u[e];
     vi = v[e];
-    pending_u(&ui, &wg, e, VB_FOLD_PENDING(state));
-    pending_v(&vi, wg, VB_FOLD_PENDING(state));
+    pending_u(&ui, &wg, e, VB_PENDING_ARGS);
+    pending_v(&vi, wg, VB_PENDING_ARGS);
   }
-  const real4 f = split_lattice_force(in && ui.w != 0, e, ui, vi, u, v, VB_LATTICE_ARGS, VB_FOLD_PENDING(state), share);
+  const real4 f = split_lattice_force(in && ui.w != 0, e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, share);
   if (!in || get_local_id(0) >= VB_SPLIT_PER) return;
   if (ui.w != 0) explicit_update(e, &ui, &vi, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, 0 VB_TRI_ARGS);
   u_pred[e] = ui;
   v_pred[e] = vi;
 #else
-  explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0, VB_FOLD_PENDING(state) VB_TRI_ARGS);
+  explicit_stage(e, u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0, VB_PENDING_ARGS VB_TRI_ARGS);
 #endif
 }
 
-kernel VB_STEP_ATTR void heun_correct(global real4* u, global real4* v, global const real4* u_pred,
-                                      global const real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS,
-                                      real dt, uint n VB_FOLD_PARAMS(state) VB_FOLD_PARAMS(pred) VB_TRI_PARAMS) {
-  VB_UNPACK_LATTICE;
-#if VB_SPLIT > 1
-  local real4 share[VB_SPLIT_WG];
-  const uint e = split_element();
+// Heun's corrector for element e (u', v' into u, v; the same calling rule as predict_element):
+// `pending` of the state (u, v) for the element's own u, v, and pred_* of the predicted stage.
+inline void correct_element(uint e, global real4* u, global real4* v, global const real4* u_pred,
+                            global const real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt, uint n,
+                            VB_PENDING_PARAMS, global const real4* pred_g, real pred_lambda, real pred_mu,
+                            int pred_pending, local real4* share VB_TRI_PARAMS) {
   const int in = e < n;
-#else
-  const uint e = get_global_id(0);
-  const int in = e < n;
+#if VB_SPLIT == 1
   if (!in) return;
 #endif
   real4 ui = (real4)(0), vi = (real4)(0), up = (real4)(0), vp = (real4)(0), wg = (real4)(0), wgp = (real4)(0);
@@ -198,21 +193,48 @@ kernel VB_STEP_ATTR void heun_correct(global real4* u, global real4* v, global c
     vi = v[e];
     up = u_pred[e];
     vp = v_pred[e];
-    pending_u(&ui, &wg, e, VB_FOLD_PENDING(state));
-    pending_v(&vi, wg, VB_FOLD_PENDING(state));
-    pending_u(&up, &wgp, e, VB_FOLD_PENDING(pred));
-    pending_v(&vp, wgp, VB_FOLD_PENDING(pred));
+    pending_u(&ui, &wg, e, VB_PENDING_ARGS);
+    pending_v(&vi, wg, VB_PENDING_ARGS);
+    pending_u(&up, &wgp, e, pred_g, pred_lambda, pred_mu, pred_pending);
+    pending_v(&vp, wgp, pred_g, pred_lambda, pred_mu, pred_pending);
   }
 #if VB_SPLIT > 1
-  const real4 f = split_lattice_force(in && ui.w != 0, e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS,
-                                      VB_FOLD_PENDING(pred), share);
+  const real4 f = split_lattice_force(in && ui.w != 0, e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, pred_g,
+                                      pred_lambda, pred_mu, pred_pending, share);
   if (!in || get_local_id(0) >= VB_SPLIT_PER) return;
   if (ui.w == 0) return;
 #else
   if (ui.w == 0) return;
-  const real4 f = lattice_force_pending(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, VB_FOLD_PENDING(pred), 0, 26);
+  const real4 f = lattice_force_pending(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, pred_g, pred_lambda, pred_mu,
+                                        pred_pending, 0, 26);
 #endif
   const real4 vn = correct_update(e, &ui, vi, up, vp, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt VB_TRI_ARGS);
   u[e] = ui;
   v[e] = vn;
+}
+
+#if VB_SPLIT > 1
+#define VB_STEP_ELEMENT split_element(get_group_id(0))
+#define VB_STEP_SHARE local real4 share[VB_SPLIT_WG]
+#else
+#define VB_STEP_ELEMENT get_global_id(0)
+#define VB_STEP_SHARE local real4* share = 0
+#endif
+
+kernel VB_STEP_ATTR void heun_predict(global const real4* u, global const real4* v, global real4* u_pred,
+                                      global real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
+                                      uint n VB_FOLD_PARAMS(state) VB_TRI_PARAMS) {
+  VB_UNPACK_LATTICE;
+  VB_STEP_SHARE;
+  predict_element(VB_STEP_ELEMENT, u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n,
+                  VB_FOLD_PENDING(state), share VB_TRI_ARGS);
+}
+
+kernel VB_STEP_ATTR void heun_correct(global real4* u, global real4* v, global const real4* u_pred,
+                                      global const real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS,
+                                      real dt, uint n VB_FOLD_PARAMS(state) VB_FOLD_PARAMS(pred) VB_TRI_PARAMS) {
+  VB_UNPACK_LATTICE;
+  VB_STEP_SHARE;
+  correct_element(VB_STEP_ELEMENT, u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n,
+                  VB_FOLD_PENDING(state), VB_FOLD_PENDING(pred), share VB_TRI_ARGS);
 }

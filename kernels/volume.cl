@@ -109,18 +109,26 @@ inline void volume_item_values(uint i, global const real4* u, global const real4
   global const uint* incident_start = (global const uint*)VB_ARENA_AT(mesh, mesh_at.s2);     \
   global const VB_INCIDENT* incident = (global const VB_INCIDENT*)VB_ARENA_AT(mesh, mesh_at.s3)
 
+// Work-group `group`'s partial sums (VB_CHECK_WG items; every work-item of the group must call).
+inline void volume_group_partials(uint group, global const real4* u, global const real4* v, VB_LATTICE_PARAMS,
+                                  VB_VOLUME_MESH_PARAMS, global real4* grad, int with_force, global real* partial,
+                                  local real* s) {
+  const uint l = get_local_id(0);
+  real value[VB_VOLUME_SLOTS];
+  volume_item_values(group * VB_CHECK_WG + l, u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, with_force, value);
+  sum_over_group(s, VB_CHECK_WG, value, l);
+  if (l == 0)
+    for (int k = 0; k < VB_VOLUME_SLOTS; ++k) partial[group * VB_VOLUME_SLOTS + k] = s[k * VB_CHECK_WG];
+  barrier(CLK_LOCAL_MEM_FENCE);  // s is free again for the group's next call
+}
+
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
 void volume_partials(global const real4* u, global const real4* v, VB_LATTICE_KERNEL_PARAMS, VB_VOLUME_MESH_KERNEL_PARAMS,
                      global real4* grad, int with_force, global real* partial) {
   VB_UNPACK_LATTICE;
   VB_UNPACK_MESH;
   local real s[VB_VOLUME_SLOTS * VB_CHECK_WG];
-  const uint l = get_local_id(0);
-  real value[VB_VOLUME_SLOTS];
-  volume_item_values(get_global_id(0), u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, with_force, value);
-  sum_over_group(s, VB_CHECK_WG, value, l);
-  if (l == 0)
-    for (int k = 0; k < VB_VOLUME_SLOTS; ++k) partial[get_group_id(0) * VB_VOLUME_SLOTS + k] = s[k * VB_CHECK_WG];
+  volume_group_partials(get_group_id(0), u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, with_force, partial, s);
 }
 
 // λ, μ, V, p from the partial sums of `groups` work-groups of `wg` items (every work-item must call
@@ -187,13 +195,14 @@ inline int partials_counted(global const real4* u, global const real4* v, VB_LAT
   if (l == 0)
     for (int k = 0; k < VB_VOLUME_SLOTS; ++k) partial[get_group_id(0) * VB_VOLUME_SLOTS + k] = s[k * wg];
   // every work-item's g and the group's partials are globally visible before the group is counted
-  mem_fence(CLK_GLOBAL_MEM_FENCE);
   barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
-  if (l == 0) *last = atomic_inc(groups_done) == get_num_groups(0) - 1;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  if (!*last) return 0;
-  mem_fence(CLK_GLOBAL_MEM_FENCE);
-  return 1;
+  if (l == 0) {
+    vb_device_fence();
+    *last = atomic_inc(groups_done) == get_num_groups(0) - 1;
+    vb_device_fence();
+  }
+  barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
+  return *last;
 }
 
 kernel __attribute__((reqd_work_group_size(VB_VOLUME_WG, 1, 1)))

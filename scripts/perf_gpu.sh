@@ -10,6 +10,9 @@
 # Switches the A/B rows also try (docs/PERF_NOTES.md, changes 7–9):
 #   VOXBREAST_FORCE_SPLIT=1|2|4      work-items per element in Heun's force passes (GPU default 2
 #                                    for hyperelastic models up to 262,144 elements)
+#   VOXBREAST_PERSISTENT=0|1         Heun's step as one launch with grid barriers (NVIDIA default
+#                                    for spring models up to 262,144 elements; the 36k rows run
+#                                    the default and =0, the target row also =1)
 #   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
 #   device: bash scripts/perf_gpu.sh      (run tool, carry [".device-pkgs"]; writes $OUT/perf)
 set -uo pipefail
@@ -29,7 +32,7 @@ if [[ -f .device-pkgs/ref.tar.xz ]]; then
   ref=$(mktemp -d) && tar -C "$ref" -xJf .device-pkgs/ref.tar.xz && ref=$ref/bin/voxbreast
 fi
 
-VOXBREAST_DEVICE=gpu run test_physics --gtest_filter='*VolumeKernels*:VolumeConstraint.*:*KernelForces*:*KernelSteps*:HyperelasticKernels.*:*Uniaxial*:*SimpleShear*:*Tension*:*PlateCompression*:*BiphasicKernels*:*RestOffsets*:*TorusContact*:*Relaxation*' \
+VOXBREAST_DEVICE=gpu run test_physics --gtest_filter='*VolumeKernels*:VolumeConstraint.*:*KernelForces*:*KernelSteps*:HyperelasticKernels.*:*Uniaxial*:*SimpleShear*:*Tension*:*PlateCompression*:*BiphasicKernels*:*RestOffsets*:*TorusContact*:*Relaxation*:PersistentStep.*' \
   2>&1 | grep -E '^\[ *(OK|FAILED|PASSED) *\]|Failure|pending vs' | tee "$out/gpu_tests.txt"
 # the split force passes (four work-items per element, any law) against the host
 VOXBREAST_DEVICE=gpu VOXBREAST_FORCE_SPLIT=4 run test_physics --gtest_filter='*KernelSteps*:HyperelasticKernels.MatchHost*' \
@@ -44,8 +47,11 @@ row() {
 }
 for round in 1 2; do
   row "36k_r$round" voxbreast --sizes 33 --laws linear ogden --volume
+  # one launch per pass instead of the persistent step (kernels/persistent.cl)
+  VOXBREAST_PERSISTENT=0 row "36k_launches_r$round" voxbreast --sizes 33 --laws linear ogden --volume
   [[ -n "$ref" ]] && row "36k_ref_r$round" "$ref" --sizes 33 --laws linear ogden --volume
 done
+VOXBREAST_PERSISTENT=1 row 36k_persistent voxbreast --sizes 33 --laws ogden --volume
 VOXBREAST_FORCE_SPLIT=1 row 36k_split1 voxbreast --sizes 33 --laws ogden --volume
 VOXBREAST_FORCE_SPLIT=4 row 36k_split4 voxbreast --sizes 33 --laws ogden --volume
 row 1.5M voxbreast --sizes 115 --laws ogden

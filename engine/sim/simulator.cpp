@@ -269,6 +269,12 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     if (heun_steps && (k == 1 || k == 2 || k == 4)) force_split_ = k;
   }
   options += " -DVB_SPLIT=" + std::to_string(force_split_);
+  options += " -DVB_NV_PTX=" + std::to_string(nvidia_ptx(cl.info));
+  // Heun's whole step in one launch where the device allows it (kernels/persistent.cl): not with
+  // triangle contact (its own pass) or folded projections (another way to fewer launches).
+  persistent_ = plan_persistent_step(cl.info, heun_steps && !tri_contact_ && !(volume_ && volume_launches_ == 0),
+                                     el.hyperelastic, n_, force_split_, kSplitMaxElements);
+  options += persistent_.options();
   {
     const std::size_t per = kSplitWorkGroup / std::size_t(force_split_);
     step_global_ = force_split_ > 1 ? cl::NDRange((n_ + per - 1) / per * kSplitWorkGroup) : global_;
@@ -289,6 +295,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   std::vector<std::string> sources = {"common.cl",         "hyperelastic.cl",     "device_contact.cl",
                                       "lattice_forces.cl", "triangle_contact.cl", "integrate.cl"};
   if (volume_) sources.push_back("volume.cl");
+  sources.push_back("persistent.cl");
   if (relax_) sources.push_back("relax.cl");
   sources.push_back("checks.cl");
   program_ = build_program(cl, sources, lattice_tables_source(), options);
@@ -343,6 +350,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   if (volume_) make_volume_buffers(surface_);
   if (!scene.tori.empty()) make_contact_area_buffer();
   if (tri_contact_) make_triangle_contact_buffers();
+  if (persistent_.on) make_persistent_kernel();
   if (rest_offsets_) set_rest_offsets(std::vector<double>(3 * n_, 0.0));  // R₀ = I, J₀ = 1
 }
 
@@ -422,6 +430,7 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   Vec3 centre = Vec3::Zero();  // positions are taken relative to it, to keep rounding small
   for (const cl_uint e : surface) centre += lattice_.rest_position(e);
   centre /= double(surface.size());
+  vol_centre_ = centre;
 
   // one buffer for the mesh (device_arena.hpp), slots as kernels/volume.cl's VB_UNPACK_MESH
   vol_mesh_.add(triangles.data(), triangles.size() * sizeof(cl_uint));
@@ -494,6 +503,7 @@ void Simulator::set_rest_volume_args() {
   set_real(vol_apply_, kApplyRestVolume, v0);
   set_real(vol_project_, kProjectRestVolume, v0);
   if (volume_launches_ == 0) set_real(vol_pending_, kProjectRestVolume, v0);
+  if (persistent_.on) set_persistent_rest_volume(v0);
 }
 
 void Simulator::set_fold_args(bool state_pending, bool pred_pending) {
@@ -838,6 +848,10 @@ void Simulator::advance(std::int64_t steps) {
         set_indenter_args(correct_, kStepIndenter, t1, t1);
       }
       const bool project = volume_ && (steps_ + 1) % scene_.volume.every == 0;
+      if (persistent_.on) {  // the whole step, its projections included
+        enqueue_persistent_step(t0, t1, project);
+        continue;
+      }
       if (volume_launches_ == 0) {
         // Projections left pending (kernels/volume.cl, volume_pending): the readers of each
         // projected state apply it, and only the state's own gradient and scalars stay pending
@@ -877,6 +891,7 @@ void Simulator::advance(std::int64_t steps) {
 }
 
 StateCheck Simulator::check() {
+  check_grid_barriers();
   apply_pending_projection();
   check_.setArg(0, u_);
   check_.setArg(1, v_);
@@ -952,7 +967,8 @@ void Simulator::adapt_relaxation_damping(const std::vector<double>& partial) {
 void Simulator::set_gravity(const Vec3& g) {
   require(scene_.gravity.active, "gravity can change only in a scene with a [gravity] section", "gravity");
   gravity_ = g;
-  for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_})
+  // the persistent step's lattice arguments start where the stepping kernels' do
+  for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_, &persistent_kernel_})
     if ((*k)()) set_world_vector(*k, kStepLattice + kLatticeGravity, g);
   set_world_vector(check_, kCheckLattice + kLatticeGravity, g);
   if (volume_) {

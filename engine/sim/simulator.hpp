@@ -15,6 +15,7 @@
 #include "engine/sim/device_arena.hpp"
 #include "engine/sim/element_setup.hpp"
 #include "engine/sim/opencl_runtime.hpp"
+#include "engine/sim/persistent_step.hpp"
 #include "engine/sim/time_step.hpp"
 #include "engine/surface/surface_mesh.hpp"
 
@@ -155,6 +156,8 @@ class Simulator {
   /// work-items per element in Heun's force passes (kernels/integrate.cl, VB_SPLIT): 2 on GPUs for
   /// hyperelastic models up to 262,144 elements, else 1; VOXBREAST_FORCE_SPLIT=1|2|4 overrides
   int force_split() const { return force_split_; }
+  /// Heun's whole step runs as one launch (kernels/persistent.cl; NVIDIA GPUs, small models)
+  bool persistent_step() const { return persistent_.on; }
 
  private:
   void set_indenter_args(cl::Kernel& k, int first_arg, double t_force, double t_project);
@@ -271,6 +274,19 @@ class Simulator {
       vol_scalars_, vol_done_;
   cl::Kernel vol_partials_, vol_finish_, vol_project_;
   mutable cl::Kernel vol_apply_;
+
+  // The persistent Heun step (kernels/persistent.cl, simulator_persistent.cpp).
+  void make_persistent_kernel();
+  void enqueue_persistent_step(double t0_s, double t1_s, bool project);
+  /// V0 (lattice frame) into the persistent kernel, once it exists
+  void set_persistent_rest_volume(double v0);
+  /// throws vb::Error when a grid barrier timed out (work-groups not all resident)
+  void check_grid_barriers() const;
+  PersistentPlan persistent_;
+  cl::Kernel persistent_kernel_;
+  cl::Buffer grid_sync_;       ///< barrier count, fault flag
+  cl_uint sync_start_ = 0;     ///< the count when the next launch starts
+  Vec3 vol_centre_ = Vec3::Zero();
 
   // Triangle contact (kernels/triangle_contact.cl): the surface mesh (surface_), uploaded once.
   void make_triangle_contact_buffers();

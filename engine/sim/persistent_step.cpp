@@ -1,0 +1,42 @@
+#include "engine/sim/persistent_step.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+
+#include "engine/sim/opencl_runtime.hpp"
+
+namespace vb {
+
+bool nvidia_ptx(const DeviceInfo& device) {
+  return device.is_gpu && (device.platform.find("NVIDIA") != std::string::npos ||
+                           device.vendor.find("NVIDIA") != std::string::npos);
+}
+
+std::string PersistentPlan::options() const {
+  if (!on) return " -DVB_PERSISTENT=0";
+  return " -DVB_PERSISTENT=1 -DVB_PERSISTENT_TRACE=" + std::to_string(trace) +
+         " -cl-nv-maxrregcount=" + std::to_string(max_registers);
+}
+
+PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, bool hyperelastic, std::size_t elements,
+                                    int force_split, std::size_t max_elements) {
+  PersistentPlan plan;
+  plan.on = eligible && !hyperelastic && nvidia_ptx(device) && elements <= max_elements && device.compute_units > 0;
+  if (const char* env = std::getenv("VOXBREAST_PERSISTENT"))
+    plan.on = eligible && nvidia_ptx(device) && device.compute_units > 0 && std::atoi(env) == 1;
+  if (!plan.on) return plan;
+  constexpr std::size_t kRegistersPerUnit = 65536, kMinPerUnit = 2, kMaxPerUnit = 6;
+  const std::size_t per_block = PersistentPlan::kWorkGroup / std::size_t(std::max(force_split, 1));
+  const std::size_t blocks = (elements + per_block - 1) / per_block;
+  std::size_t per_unit =
+      std::clamp((blocks + device.compute_units - 1) / device.compute_units, kMinPerUnit, kMaxPerUnit);
+  if (const char* env = std::getenv("VOXBREAST_PERSISTENT_GROUPS"))  // per compute unit, to compare
+    per_unit = std::clamp<std::size_t>(std::size_t(std::max(std::atoi(env), 1)), 1, 8);
+  const char* trace = std::getenv("VOXBREAST_PERSISTENT_TRACE");
+  plan.trace = trace && std::atoi(trace) == 1;
+  plan.groups = per_unit * device.compute_units;
+  plan.max_registers = int(std::min<std::size_t>(255, kRegistersPerUnit / (PersistentPlan::kWorkGroup * per_unit) / 8 * 8));
+  return plan;
+}
+
+}  // namespace vb

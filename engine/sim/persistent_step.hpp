@@ -1,0 +1,34 @@
+#pragma once
+/// Heun's whole step in one launch on NVIDIA GPUs (kernels/persistent.cl): when to use it, and how
+/// many work-groups to launch so that all are resident at once (they wait for each other).
+#include <cstddef>
+#include <string>
+
+namespace vb {
+
+struct DeviceInfo;
+
+/// The device takes inline PTX (NVIDIA's OpenCL): device-scope fences, the persistent step.
+bool nvidia_ptx(const DeviceInfo& device);
+
+struct PersistentPlan {
+  bool on = false;
+  std::size_t groups = 0;   ///< work-groups of kWorkGroup work-items, all resident
+  int max_registers = 0;    ///< per work-item, so that groups / compute units fit on one
+  bool trace = false;       ///< VOXBREAST_PERSISTENT_TRACE=1: pass times printed at each check
+  static constexpr std::size_t kWorkGroup = 128;  ///< VB_PERSISTENT_WG
+  /// build options: -DVB_PERSISTENT=0|1 and, when on, NVIDIA's register cap
+  std::string options() const;
+};
+
+/// Heun scenes without triangle contact or folded volume projections, on an NVIDIA GPU: by default
+/// spring models up to `max_elements` (VOXBREAST_PERSISTENT=0 turns it off, =1 on for any size and
+/// for hyperelastic models, where it measured slower: docs/PERF_NOTES.md change 12). Groups per
+/// compute unit: enough for one block of elements per group in the widest pass (force_split
+/// work-items per element), 2 to 6; the register cap 65,536 / (128 · groups per unit), in
+/// multiples of 8, is what NVIDIA's register file then lets reside. VOXBREAST_PERSISTENT_GROUPS=k
+/// sets the groups per compute unit (1–8), to compare.
+PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, bool hyperelastic, std::size_t elements,
+                                    int force_split, std::size_t max_elements);
+
+}  // namespace vb

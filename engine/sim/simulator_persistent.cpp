@@ -1,0 +1,80 @@
+// The persistent Heun step (kernels/persistent.cl): its kernel's arguments, its launches, and the
+// check that its grid barriers never timed out.
+#include <iostream>
+
+#include "engine/error.hpp"
+#include "engine/sim/simulator.hpp"
+
+namespace vb {
+namespace {
+
+// heun_step_persistent's arguments (kernels/persistent.cl): u, v, ũ, ṽ, the lattice (10), the
+// obstacles, t0, t1, dt, n, rest frames; with the volume constraint 11 more; then sync, target.
+constexpr int kLattice = 4, kIndenters = kLattice + 10, kDt = kIndenters + 3, kRestFrame = kDt + 2;
+constexpr int kMesh = kRestFrame + 1, kRestVolume = kMesh + 8, kProject = kMesh + 10;
+constexpr int kSyncWords = 2 + 12;  // count, fault flag, VB_PERSISTENT_TRACE's stamps (≤ 9 barriers + 2)
+
+}  // namespace
+
+void Simulator::make_persistent_kernel() {
+  cl::Kernel& k = persistent_kernel_ = cl::Kernel(program_, "heun_step_persistent");
+  k.setArg(0, u_);
+  k.setArg(1, v_);
+  k.setArg(2, u_tmp_);
+  k.setArg(3, v_tmp_);
+  set_lattice_args(k, kLattice);
+  set_indenter_args(k, kIndenters, 0.0, 0.0);
+  set_real(k, kDt, dt_.dt_s);
+  k.setArg(kDt + 1, cl_uint(n_));
+  k.setArg(kRestFrame, rest_frame_);
+  int a = kMesh;
+  if (volume_) {
+    k.setArg(kMesh, vol_mesh_.buffer());
+    k.setArg(kMesh + 1, vol_mesh_at_);
+    k.setArg(kMesh + 2, cl_uint(volume_triangles_));
+    k.setArg(kMesh + 3, cl_uint(volume_surface_));
+    set_world_vector(k, kMesh + 4, vol_centre_);
+    k.setArg(kMesh + 5, vol_grad_);
+    k.setArg(kMesh + 6, vol_partial_);
+    k.setArg(kMesh + 7, cl_uint(volume_groups_));
+    set_real(k, kRestVolume, frame_sign_ * rest_volume_m3_);
+    k.setArg(kMesh + 9, vol_scalars_);
+    a = kProject + 1;
+  }
+  const cl_uint zeros[kSyncWords] = {};  // barrier count, fault flag, trace stamps
+  grid_sync_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof zeros, const_cast<cl_uint*>(zeros));
+  k.setArg(a, grid_sync_);
+}
+
+void Simulator::set_persistent_rest_volume(double v0) {
+  if (persistent_kernel_()) set_real(persistent_kernel_, kRestVolume, v0);
+}
+
+void Simulator::enqueue_persistent_step(double t0_s, double t1_s, bool project) {
+  cl::Kernel& k = persistent_kernel_;
+  if (!scene_.indenters.empty() || !scene_.tori.empty()) set_indenter_args(k, kIndenters, t0_s, t1_s);
+  if (volume_) k.setArg(kProject, cl_int(project));
+  const int last = int(k.getInfo<CL_KERNEL_NUM_ARGS>()) - 1;
+  k.setArg(last, sync_start_);
+  launch(k, cl::NDRange(persistent_.groups * PersistentPlan::kWorkGroup), cl::NDRange(PersistentPlan::kWorkGroup));
+  // the kernel's grid barriers: 2 around the stress passes, 1 after the predictor, 4 per projection
+  const cl_uint barriers = cl_uint(1 + (hyper_ ? 2 : 0) + (project ? 4 : 0));
+  sync_start_ += barriers * cl_uint(persistent_.groups);  // wraps as the kernel's count does
+}
+
+void Simulator::check_grid_barriers() const {
+  if (!persistent_.on) return;
+  cl_uint sync[kSyncWords] = {};
+  cl_.queue.enqueueReadBuffer(grid_sync_, CL_TRUE, 0, sizeof sync, sync);
+  if (persistent_.trace) {  // ns between group 0's stamps of the last launch: pass by pass
+    std::cerr << "persistent step, " << persistent_.groups << " groups, last launch's passes (us):";
+    for (int k = 3; k < kSyncWords && sync[k] != 0; ++k) std::cerr << ' ' << 1e-3 * double(sync[k] - sync[k - 1]);
+    std::cerr << '\n';
+  }
+  require(sync[1] == 0,
+          "the persistent Heun step's work-groups were not all resident on the device (a grid barrier timed out), "
+          "so the state is not valid",
+          "device", "set VOXBREAST_PERSISTENT=0 to step with one launch per pass");
+}
+
+}  // namespace vb

@@ -1,0 +1,108 @@
+// Heun's whole step as one launch with grid barriers (kernels/persistent.cl) against one launch per
+// pass. Runs on NVIDIA GPUs only (VOXBREAST_DEVICE=gpu, scripts/perf_gpu.sh); elsewhere the
+// persistent step is not offered and the tests skip.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "engine/sim/simulator.hpp"
+#include "tests/engine/sim/sim_fixtures.hpp"
+
+namespace vb {
+namespace {
+
+enum class Case { SpringsVolume, OgdenVolumeEveryThird, OgdenPlates };
+
+Scene make_case(Case c) {
+  if (c == Case::OgdenPlates) {  // a moving plate: the stage times t0, t1 reach the contact
+    Scene s = test::box_scene(8, 8, 8, 0.002, 3000);
+    s.materials["soft"] = test::validation_material("ogden", 0.45);
+    s.indenters = test::plate_pair(8, 0.002, 0.9);
+    s.solver.precision = Precision::Double;
+    s.solver.dashpot_ratio = 0.1;
+    return s;
+  }
+  Scene s = test::box_scene(10, 10, 11, 0.005, 3000);
+  if (c == Case::OgdenVolumeEveryThird) s.materials["soft"] = test::validation_material("ogden", 0.45);
+  s.volume.preserve = true;
+  s.volume.every = c == Case::OgdenVolumeEveryThird ? 3 : 1;
+  s.anchors.push_back(test::halfspace_anchor("base", Vec3(0, 0, 0.0025), Vec3(0, 0, -1)));
+  s.gravity.active = true;
+  s.gravity.acceleration_m_s2 = Vec3(0, 0, -9.81);
+  s.solver.precision = Precision::Double;
+  s.solver.dashpot_ratio = 0.1;
+  return s;
+}
+
+/// u then v after 150 Heun steps from rest with checks after steps 50 and 100 (and gravity turned
+/// after step 50 where the scene has it: set_gravity must reach the persistent kernel), the step as one
+/// launch (`persistent`, VOXBREAST_PERSISTENT=1) or one launch per pass; empty when the device
+/// has no persistent step.
+std::vector<double> run_case(Case c, bool persistent, int split = 0) {
+  const Scene s = make_case(c);
+  const test::Model m = test::make_model(s);
+  setenv("VOXBREAST_PERSISTENT", persistent ? "1" : "0", 1);
+  if (split) setenv("VOXBREAST_FORCE_SPLIT", std::to_string(split).c_str(), 1);
+  Simulator sim(s, m.lattice, m.elements, test::cl_context());
+  unsetenv("VOXBREAST_PERSISTENT");
+  unsetenv("VOXBREAST_FORCE_SPLIT");
+  if (sim.persistent_step() != persistent) return {};
+  for (int k = 0; k < 3; ++k) {
+    sim.advance(50);
+    if (k < 2) EXPECT_EQ(sim.check().nonfinite_elements, 0);
+    if (k == 0 && s.gravity.active) sim.set_gravity(Vec3(0, 4.9, -8.5));  // a posture change reaches both
+  }
+  std::vector<double> u, v;
+  sim.download(u, v);
+  u.insert(u.end(), v.begin(), v.end());
+  return u;
+}
+
+/// largest difference over the largest |u|, |v| of the reference
+double relative_difference(const std::vector<double>& got, const std::vector<double>& ref) {
+  EXPECT_EQ(got.size(), ref.size());
+  double largest = 0, diff = 0;
+  for (std::size_t i = 0; i < got.size() && i < ref.size(); ++i) {
+    EXPECT_TRUE(std::isfinite(got[i]));
+    largest = std::max(largest, std::abs(ref[i]));
+    diff = std::max(diff, std::abs(got[i] - ref[i]));
+  }
+  EXPECT_GT(largest, 0);
+  return diff / largest;
+}
+
+// Every pass of the step in one launch: a pass that started before the previous one had finished
+// everywhere (a missing or leaky grid barrier), a stale cached read of another group's writes, a
+// block of elements skipped or done twice, or a projection applied on the wrong steps would give
+// another trajectory than one launch per pass. The same sums in the same order: equal to rounding.
+TEST(PersistentStep, MatchesOneLaunchPerPass) {
+  const char* names[] = {"springs + volume", "two-term Ogden + volume every third step", "two-term Ogden + moving plate"};
+  int k = 0;
+  for (const Case c : {Case::SpringsVolume, Case::OgdenVolumeEveryThird, Case::OgdenPlates}) {
+    const std::vector<double> one = run_case(c, true);
+    if (one.empty()) GTEST_SKIP() << "no persistent step on this device (NVIDIA GPUs only)";
+    const double d = relative_difference(one, run_case(c, false));
+    std::cout << names[k] << ": persistent vs one launch per pass, largest difference over largest |u|, |v|: " << d
+              << "\n";
+    EXPECT_LE(d, 1e-12) << names[k];
+    ++k;
+  }
+}
+
+// The force passes' blocks with one and four work-items per element (VB_SPLIT): the persistent
+// step's block walk must cover both layouts.
+TEST(PersistentStep, MatchesWithEveryForceSplit) {
+  for (const int split : {1, 4}) {
+    const std::vector<double> one = run_case(Case::OgdenVolumeEveryThird, true, split);
+    if (one.empty()) GTEST_SKIP() << "no persistent step on this device (NVIDIA GPUs only)";
+    EXPECT_LE(relative_difference(one, run_case(Case::OgdenVolumeEveryThird, false, split)), 1e-12) << split;
+  }
+}
+
+}  // namespace
+}  // namespace vb
