@@ -12,6 +12,7 @@
 
 #include "engine/sim/simulator.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
+#include "tests/engine/sim/trajectory_compare.hpp"
 
 namespace vb {
 namespace {
@@ -63,18 +64,6 @@ std::vector<double> run_case(Case c, bool persistent, int split = 0) {
   return u;
 }
 
-/// largest difference over the largest |u|, |v| of the reference
-double relative_difference(const std::vector<double>& got, const std::vector<double>& ref) {
-  EXPECT_EQ(got.size(), ref.size());
-  double largest = 0, diff = 0;
-  for (std::size_t i = 0; i < got.size() && i < ref.size(); ++i) {
-    EXPECT_TRUE(std::isfinite(got[i]));
-    largest = std::max(largest, std::abs(ref[i]));
-    diff = std::max(diff, std::abs(got[i] - ref[i]));
-  }
-  EXPECT_GT(largest, 0);
-  return diff / largest;
-}
 
 // Every pass of the step in one launch: a pass that started before the previous one had finished
 // everywhere (a missing or leaky grid barrier), a stale cached read of another group's writes, a
@@ -86,7 +75,7 @@ TEST(PersistentStep, MatchesOneLaunchPerPass) {
   for (const Case c : {Case::SpringsVolume, Case::OgdenVolumeEveryThird, Case::OgdenPlates}) {
     const std::vector<double> one = run_case(c, true);
     if (one.empty()) GTEST_SKIP() << "no persistent step on this device (NVIDIA GPUs only)";
-    const double d = relative_difference(one, run_case(c, false));
+    const double d = test::relative_difference(one, run_case(c, false));
     std::cout << names[k] << ": persistent vs one launch per pass, largest difference over largest |u|, |v|: " << d
               << "\n";
     EXPECT_LE(d, 1e-12) << names[k];
@@ -100,7 +89,7 @@ TEST(PersistentStep, MatchesWithEveryForceSplit) {
   for (const int split : {1, 4}) {
     const std::vector<double> one = run_case(Case::OgdenVolumeEveryThird, true, split);
     if (one.empty()) GTEST_SKIP() << "no persistent step on this device (NVIDIA GPUs only)";
-    EXPECT_LE(relative_difference(one, run_case(Case::OgdenVolumeEveryThird, false, split)), 1e-12) << split;
+    EXPECT_LE(test::relative_difference(one, run_case(Case::OgdenVolumeEveryThird, false, split)), 1e-12) << split;
   }
 }
 

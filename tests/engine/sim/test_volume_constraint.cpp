@@ -15,6 +15,7 @@
 #include "io/nifti_io.hpp"
 #include "io/scene_file.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
+#include "tests/engine/sim/trajectory_compare.hpp"
 
 namespace vb {
 namespace {
@@ -196,21 +197,9 @@ std::vector<double> project_steps(int launches, bool ogden = false, int every = 
 // volume_project's last work-group sums every group's partials (~10 groups here): a group
 // counted before its partials or gradients were visible, or a missed reset of the count, would
 // give another λ, μ and another trajectory than the two-launch form.
-/// largest difference of two project_steps results over their largest |u|, |v|
-double relative_difference(const std::vector<double>& one, const std::vector<double>& two) {
-  EXPECT_EQ(one.size(), two.size());
-  double largest = 0, diff = 0;
-  for (std::size_t i = 0; i < one.size() && i < two.size(); ++i) {
-    EXPECT_TRUE(std::isfinite(one[i]));
-    largest = std::max(largest, std::abs(two[i]));
-    diff = std::max(diff, std::abs(one[i] - two[i]));
-  }
-  EXPECT_GT(largest, 0);
-  return diff / largest;
-}
 
 TEST(VolumeConstraint, OneLaunchProjectionMatchesTwoLaunches) {
-  EXPECT_LE(relative_difference(project_steps(1), project_steps(2)), 1e-12);
+  EXPECT_LE(test::relative_difference(project_steps(1), project_steps(2)), 1e-12);
 }
 
 // VOXBREAST_VOLUME_LAUNCHES=0: no volume_apply in the step; the stress pass and the stepping
@@ -219,8 +208,8 @@ TEST(VolumeConstraint, OneLaunchProjectionMatchesTwoLaunches) {
 // applied the wrong one (the state's instead of the predicted stage's) gives another trajectory.
 // Two-term Ogden projecting every third step has steps with and without pending projections.
 TEST(VolumeConstraint, PendingProjectionMatchesTwoLaunches) {
-  const double springs = relative_difference(project_steps(0), project_steps(2));
-  const double ogden = relative_difference(project_steps(0, true, 3), project_steps(2, true, 3));
+  const double springs = test::relative_difference(project_steps(0), project_steps(2));
+  const double ogden = test::relative_difference(project_steps(0, true, 3), project_steps(2, true, 3));
   std::cout << "pending vs two launches, largest difference over largest |u|, |v|: springs " << springs
             << ", two-term Ogden (every third step) " << ogden << "\n";
   EXPECT_LE(springs, 1e-12);
