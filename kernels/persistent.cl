@@ -66,6 +66,13 @@ inline void grid_barrier(volatile global uint* sync, uint target, uint* stamps) 
 #endif
 // every group walks the blocks of `count` items it owns (uniform in the group: barriers inside are safe)
 #define VB_FOR_BLOCKS(b, count) for (uint b = get_group_id(0); b < (count); b += get_num_groups(0))
+// The split force passes' `share`: part 0 reads the other parts' sums after a barrier, so the
+// next block's parts may write it only after another.
+#if VB_SPLIT > 1
+#define VB_BLOCK_DONE barrier(CLK_LOCAL_MEM_FENCE)
+#else
+#define VB_BLOCK_DONE
+#endif
 
 #if VB_HYPER
 inline void stress_pass(global const real4* u, global uchar* arena, uint8 at, int sy, int sz, real h, uint n,
@@ -133,9 +140,11 @@ void heun_step_persistent(global real4* u, global real4* v, global real4* u_pred
   stress_pass(u, arena_rw, at, sy, sz, h, n, rest_frame);
   grid_barrier(sync, VB_NEXT_BARRIER, &stamps);
 #endif
-  VB_FOR_BLOCKS(b, blocks)
-  predict_element(VB_BLOCK_ELEMENT(b), u, v, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t0, t1, dt, n,
-                  VB_NO_PENDING, share);
+  VB_FOR_BLOCKS(b, blocks) {
+    predict_element(VB_BLOCK_ELEMENT(b), u, v, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t0, t1, dt, n,
+                    VB_NO_PENDING, share);
+    VB_BLOCK_DONE;
+  }
   grid_barrier(sync, VB_NEXT_BARRIER, &stamps);
 #if VB_VOLUME
   if (project) {
@@ -148,9 +157,11 @@ void heun_step_persistent(global real4* u, global real4* v, global real4* u_pred
   stress_pass(u_pred, arena_rw, at, sy, sz, h, n, rest_frame);
   grid_barrier(sync, VB_NEXT_BARRIER, &stamps);
 #endif
-  VB_FOR_BLOCKS(b, blocks)
-  correct_element(VB_BLOCK_ELEMENT(b), u, v, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t1, t1, dt, n,
-                  VB_NO_PENDING, VB_NO_PENDING, share);
+  VB_FOR_BLOCKS(b, blocks) {
+    correct_element(VB_BLOCK_ELEMENT(b), u, v, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t1, t1, dt, n,
+                    VB_NO_PENDING, VB_NO_PENDING, share);
+    VB_BLOCK_DONE;
+  }
 #if VB_VOLUME
   if (project) {
     grid_barrier(sync, VB_NEXT_BARRIER, &stamps);

@@ -35,6 +35,8 @@ PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, boo
   const char* trace = std::getenv("VOXBREAST_PERSISTENT_TRACE");
   plan.trace = trace && std::atoi(trace) == 1;
   plan.groups = per_unit * device.compute_units;
+  if (const char* env = std::getenv("VOXBREAST_PERSISTENT_GROUP_LIMIT"))  // tests: several blocks per group
+    plan.groups = std::clamp<std::size_t>(std::size_t(std::max(std::atoi(env), 1)), 1, plan.groups);
   plan.max_registers = int(std::min<std::size_t>(255, kRegistersPerUnit / (PersistentPlan::kWorkGroup * per_unit) / 8 * 8));
   return plan;
 }

@@ -27,7 +27,8 @@ struct PersistentPlan {
 /// compute unit: enough for one block of elements per group in the widest pass (force_split
 /// work-items per element), 2 to 6; the register cap 65,536 / (128 · groups per unit), in
 /// multiples of 8, is what NVIDIA's register file then lets reside. VOXBREAST_PERSISTENT_GROUPS=k
-/// sets the groups per compute unit (1–8), to compare.
+/// sets the groups per compute unit (1–8), to compare; VOXBREAST_PERSISTENT_GROUP_LIMIT=N at most N
+/// groups in all, so that tests make each group walk several blocks.
 PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, bool hyperelastic, std::size_t elements,
                                     int force_split, std::size_t max_elements);
 
