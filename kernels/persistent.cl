@@ -34,12 +34,12 @@ inline void trace_stamp(volatile global uint* sync, uint k) {
 #define trace_stamp(sync, k)
 #endif
 
-// Grid-wide barrier number k of this launch: every group counts itself in sync[0] and waits until
-// all have (sync[0] grows by the number of groups per barrier; the host passes each launch's
-// start, and the comparison survives the count's wrap-around). Work-group 0's item 0 is the one
-// that fences: its device fence (membar.gl) publishes the group's writes before it counts and,
-// after the wait, makes the SM's loads miss lines other groups have since written (without it the
-// persistent test kernel read stale L1 lines).
+// Grid-wide barrier: every group counts itself in sync[0] and waits until the count reaches
+// `target` (it grows by the number of groups per barrier; the host passes each launch's start, and
+// the comparison survives the count's wrap-around). In each group item 0 fences, between
+// work-group barriers: its device fence (membar.gl) publishes the group's writes before it counts
+// and, after the wait, makes the SM's loads miss lines other groups have since written (with
+// OpenCL's mem_fence instead, a test kernel read stale L1 lines: docs/PERF_NOTES.md change 12).
 inline void grid_barrier(volatile global uint* sync, uint target, uint* stamps) {
   barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
   if (get_local_id(0) == 0) {

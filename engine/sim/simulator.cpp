@@ -1006,6 +1006,7 @@ std::vector<double> Simulator::to_lattice_frame(const std::vector<double>& world
 }
 
 void Simulator::download(std::vector<double>& u, std::vector<double>& v) const {
+  check_grid_barriers();  // a state the persistent step left invalid is never handed out
   apply_pending_projection();
   if (precision_ == Precision::Double) {
     read_xyz<double>(u_, u);

@@ -280,7 +280,8 @@ class Simulator {
   void enqueue_persistent_step(double t0_s, double t1_s, bool project);
   /// V0 (lattice frame) into the persistent kernel, once it exists
   void set_persistent_rest_volume(double v0);
-  /// throws vb::Error when a grid barrier timed out (work-groups not all resident)
+  /// throws vb::Error when a grid barrier timed out (work-groups not all resident); check() and
+  /// download() call it
   void check_grid_barriers() const;
   PersistentPlan persistent_;
   cl::Kernel persistent_kernel_;
