@@ -503,7 +503,7 @@ void Simulator::set_rest_volume_args() {
   set_real(vol_apply_, kApplyRestVolume, v0);
   set_real(vol_project_, kProjectRestVolume, v0);
   if (volume_launches_ == 0) set_real(vol_pending_, kProjectRestVolume, v0);
-  if (persistent_.on) set_persistent_rest_volume(v0);
+  if (persistent_kernel_()) set_persistent_rest_volume(v0);
 }
 
 void Simulator::set_fold_args(bool state_pending, bool pred_pending) {
@@ -843,14 +843,14 @@ void Simulator::advance(std::int64_t steps) {
     const double t0 = double(steps_) * dt, t1 = double(steps_ + 1) * dt;
     if (has_paths) follow_paths(t0);
     if (scene_.solver.integrator == Integrator::Heun) {
+      const bool project = volume_ && (steps_ + 1) % scene_.volume.every == 0;
+      if (persistent_.on) {  // the whole step, its projections included
+        enqueue_persistent_step(t0, t1, indenter, project);
+        continue;
+      }
       if (indenter) {
         set_indenter_args(predict_, kStepIndenter, t0, t1);
         set_indenter_args(correct_, kStepIndenter, t1, t1);
-      }
-      const bool project = volume_ && (steps_ + 1) % scene_.volume.every == 0;
-      if (persistent_.on) {  // the whole step, its projections included
-        enqueue_persistent_step(t0, t1, project);
-        continue;
       }
       if (volume_launches_ == 0) {
         // Projections left pending (kernels/volume.cl, volume_pending): the readers of each

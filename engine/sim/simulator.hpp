@@ -277,8 +277,8 @@ class Simulator {
 
   // The persistent Heun step (kernels/persistent.cl, simulator_persistent.cpp).
   void make_persistent_kernel();
-  void enqueue_persistent_step(double t0_s, double t1_s, bool project);
-  /// V0 (lattice frame) into the persistent kernel, once it exists
+  void enqueue_persistent_step(double t0_s, double t1_s, bool moving_obstacles, bool project);
+  /// V0 (lattice frame) into the persistent kernel (set_rest_volume_args calls it)
   void set_persistent_rest_volume(double v0);
   /// throws vb::Error when a grid barrier timed out (work-groups not all resident); check() and
   /// download() call it

@@ -13,6 +13,8 @@ namespace {
 constexpr int kLattice = 4, kIndenters = kLattice + 10, kDt = kIndenters + 3, kRestFrame = kDt + 2;
 constexpr int kMesh = kRestFrame + 1, kRestVolume = kMesh + 8, kProject = kMesh + 10;
 constexpr int kSyncWords = 2 + 12;  // count, fault flag, VB_PERSISTENT_TRACE's stamps (≤ 9 barriers + 2)
+/// the sync buffer's argument; the launch's first barrier target follows it
+constexpr int sync_arg(bool volume) { return volume ? kProject + 1 : kMesh; }
 
 }  // namespace
 
@@ -27,7 +29,6 @@ void Simulator::make_persistent_kernel() {
   set_real(k, kDt, dt_.dt_s);
   k.setArg(kDt + 1, cl_uint(n_));
   k.setArg(kRestFrame, rest_frame_);
-  int a = kMesh;
   if (volume_) {
     k.setArg(kMesh, vol_mesh_.buffer());
     k.setArg(kMesh + 1, vol_mesh_at_);
@@ -37,25 +38,24 @@ void Simulator::make_persistent_kernel() {
     k.setArg(kMesh + 5, vol_grad_);
     k.setArg(kMesh + 6, vol_partial_);
     k.setArg(kMesh + 7, cl_uint(volume_groups_));
-    set_real(k, kRestVolume, frame_sign_ * rest_volume_m3_);
     k.setArg(kMesh + 9, vol_scalars_);
-    a = kProject + 1;
+    set_rest_volume_args();  // V0 (kRestVolume), where every projecting kernel gets it
   }
   const cl_uint zeros[kSyncWords] = {};  // barrier count, fault flag, trace stamps
   grid_sync_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof zeros, const_cast<cl_uint*>(zeros));
-  k.setArg(a, grid_sync_);
+  k.setArg(sync_arg(volume_), grid_sync_);
 }
 
-void Simulator::set_persistent_rest_volume(double v0) {
-  if (persistent_kernel_()) set_real(persistent_kernel_, kRestVolume, v0);
-}
+void Simulator::set_persistent_rest_volume(double v0) { set_real(persistent_kernel_, kRestVolume, v0); }
 
-void Simulator::enqueue_persistent_step(double t0_s, double t1_s, bool project) {
+void Simulator::enqueue_persistent_step(double t0_s, double t1_s, bool moving_obstacles, bool project) {
   cl::Kernel& k = persistent_kernel_;
-  if (!scene_.indenters.empty() || !scene_.tori.empty()) set_indenter_args(k, kIndenters, t0_s, t1_s);
+  if (moving_obstacles) {  // the stage times (the obstacle table is set once)
+    set_real(k, kIndenters + 1, t0_s);
+    set_real(k, kIndenters + 2, t1_s);
+  }
   if (volume_) k.setArg(kProject, cl_int(project));
-  const int last = int(k.getInfo<CL_KERNEL_NUM_ARGS>()) - 1;
-  k.setArg(last, sync_start_);
+  k.setArg(sync_arg(volume_) + 1, sync_start_);
   launch(k, cl::NDRange(persistent_.groups * PersistentPlan::kWorkGroup), cl::NDRange(PersistentPlan::kWorkGroup));
   // the kernel's grid barriers: 2 around the stress passes, 1 after the predictor, 4 per projection
   const cl_uint barriers = cl_uint(1 + (hyper_ ? 2 : 0) + (project ? 4 : 0));

@@ -66,7 +66,6 @@ std::vector<double> run_case(Case c, bool persistent, int split = 0, int group_l
   return u;
 }
 
-
 // Every pass of the step in one launch: a pass that started before the previous one had finished
 // everywhere (a missing or leaky grid barrier), a stale cached read of another group's writes, a
 // block of elements skipped or done twice, or a projection applied on the wrong steps would give

@@ -197,7 +197,6 @@ std::vector<double> project_steps(int launches, bool ogden = false, int every = 
 // volume_project's last work-group sums every group's partials (~10 groups here): a group
 // counted before its partials or gradients were visible, or a missed reset of the count, would
 // give another λ, μ and another trajectory than the two-launch form.
-
 TEST(VolumeConstraint, OneLaunchProjectionMatchesTwoLaunches) {
   EXPECT_LE(test::relative_difference(project_steps(1), project_steps(2)), 1e-12);
 }
