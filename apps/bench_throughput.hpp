@@ -15,6 +15,9 @@ struct ThroughputOptions {
   bool quick = false;                       ///< 0.5 s per timing, Heun + float only
   bool volume = false;   ///< also time each law with [volume] preserve = true (model "block_volume")
   bool profile = false;  ///< print device time per kernel (a second, profiling run of each block)
+  /// the breast phantom's scene.toml: also time it resampled to ~36k elements (models "breast",
+  /// "breast_volume"), every law; empty: blocks only
+  std::string breast_scene;
 };
 
 struct ThroughputResult {
@@ -23,7 +26,7 @@ struct ThroughputResult {
   std::string csv;  ///< throughput.csv
 };
 
-/// Times every block; prints one line per block.
+/// Times every model; prints one line per model.
 ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& options);
 
 }  // namespace vb::app

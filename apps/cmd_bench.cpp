@@ -19,6 +19,7 @@
 #include "engine/bench/bench_knobs.hpp"
 #include "engine/bench/bench_table.hpp"
 #include "engine/bench/standard_study.hpp"
+#include "engine/error.hpp"
 #include "engine/haptic/haptic_bench.hpp"
 #include "engine/haptic/haptic_report.hpp"
 #include "engine/lattice/voxelise.hpp"
@@ -34,6 +35,7 @@ struct BenchOptions {
   std::string out, device, phantom;
   bool quick = false, large = false, no_study = false, dry_run = false, haptic = false;
   bool volume = false, profile = false;  ///< throughput: block_volume cases; per-kernel device times
+  bool breast = false;  ///< throughput: the phantom at ~36k elements too
   std::vector<int> sizes;  ///< throughput blocks (edge lengths in elements)
   std::vector<int> haptic_elements = {10000};  ///< haptic-rate blocks (about this many elements)
   double haptic_seconds = 3;
@@ -144,6 +146,10 @@ int run_bench(BenchOptions o) {
     t.quick = o.quick;
     t.volume = o.volume;
     t.profile = o.profile;
+    if (o.breast) {
+      require(!o.phantom.empty(), "--breast needs the phantom's scene", "bench --breast", "give --phantom");
+      t.breast_scene = o.phantom;
+    }
     if (!o.laws.empty()) t.laws = o.laws;
     const ThroughputResult tr = run_throughput(*cl, t);
     doc["copy_bandwidth_gb_s"] = tr.copy_bandwidth_gb_s;
@@ -215,6 +221,8 @@ Command add_bench(CLI::App& app) {
   sub->add_flag("--no-study", o->no_study, "skip the speed/accuracy study (throughput only)");
   sub->add_option("--sizes", o->sizes, "throughput: time cubes of these edge lengths in elements (e.g. 33 115)")
       ->check(CLI::Range(2, 1000));
+  sub->add_flag("--breast", o->breast,
+                "throughput: also time the breast phantom resampled to ~36k elements (models breast, breast_volume)");
   sub->add_flag("--volume", o->volume, "throughput: also time each law with [volume] preserve = true (model block_volume)");
   sub->add_flag("--profile", o->profile, "throughput: print the device time and launches per step of each kernel "
                                          "(a second run of each block on a profiling queue)");

@@ -8,3 +8,19 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$bin" bench --quick --out "$work" --phantom "$root/data-samples/phantom/scene.toml"
 /usr/bin/python3 "$root/tests/apps/check_bench.py" "$work"
+
+# Throughput of the breast phantom at ~36k elements (--breast), with and without the volume
+# constraint: rows present, the model's size, finite positive rates.
+"$bin" bench --quick --no-study --breast --volume --sizes 8 --laws linear --out "$work/throughput" \
+  --phantom "$root/data-samples/phantom/scene.toml"
+/usr/bin/python3 - "$work/throughput/throughput.csv" <<'PY'
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+breast = {r["model"]: r for r in rows if r["model"].startswith("breast")}
+assert set(breast) == {"breast", "breast_volume"}, breast.keys()
+for r in breast.values():
+    assert r["elements"] == "34961", r  # the phantom resampled at 3.2 mm
+    rate = float(r["steps_per_s"])
+    assert math.isfinite(rate) and rate > 0, r
+print("breast throughput rows:", {m: round(float(r["steps_per_s"]), 1) for m, r in breast.items()})
+PY
