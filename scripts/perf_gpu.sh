@@ -51,12 +51,14 @@ for round in 1 2; do
   VOXBREAST_PERSISTENT=0 row "36k_launches_r$round" voxbreast --sizes 33 --laws linear ogden --volume
   [[ -n "$ref" ]] && row "36k_ref_r$round" "$ref" --sizes 33 --laws linear ogden --volume
 done
+# the breast phantom at 3.2 mm (34,961 elements, a third of them moving) next to the cube
+row 36k_breast voxbreast --breast --sizes 33 --laws linear neo-hookean ogden --volume
 VOXBREAST_PERSISTENT=1 row 36k_persistent voxbreast --sizes 33 --laws ogden --volume
 VOXBREAST_FORCE_SPLIT=1 row 36k_split1 voxbreast --sizes 33 --laws ogden --volume
 VOXBREAST_FORCE_SPLIT=4 row 36k_split4 voxbreast --sizes 33 --laws ogden --volume
 row 1.5M voxbreast --sizes 115 --laws ogden
 [[ -n "$ref" ]] && row 1.5M_ref "$ref" --sizes 115 --laws ogden
-grep -hE '^== |^block(_volume)? +[0-9]+ elements' "$out"/*.txt | tee "$out/summary.txt"
+grep -hE '^== |^(block|breast)(_volume)? +[0-9]+ elements' "$out"/*.txt | tee "$out/summary.txt"
 # PTX and build logs (registers, spills) of the 36k Ogden + volume program
 VOXBREAST_DUMP_KERNELS="$out/ptx" VOXBREAST_CL_OPTIONS=-cl-nv-verbose \
   run voxbreast bench --device gpu --quick --no-study --sizes 8 --laws ogden --volume --out "$out/ptx_run" >/dev/null 2>&1
