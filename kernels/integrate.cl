@@ -12,8 +12,8 @@
 // `grip` collects the indenters' friction (device_contact.cl), turned into m/s² like the torus's.
 // With VB_TRI_CONTACT the triangle-contact forces (triangle_contact.cl, computed for the same u
 // just before this kernel) are added, and with friction their grip; VB_TRI_PARAMS is empty otherwise.
-inline real4 acceleration_from(real4 f, uint e, real4 ui, real4 vi, VB_LATTICE_PARAMS,
-                               global const real* indenters, real t, torus_grip* grip VB_TRI_PARAMS) {
+VB_INLINE real4 acceleration_from(real4 f, uint e, real4 ui, real4 vi, VB_LATTICE_PARAMS,
+                                  global const real* indenters, real t, torus_grip* grip VB_TRI_PARAMS) {
 #if VB_GRAVITY
   f += xyz0(gravity) / ui.w;
 #endif
@@ -30,16 +30,16 @@ inline real4 acceleration_from(real4 f, uint e, real4 ui, real4 vi, VB_LATTICE_P
   return f * ui.w;
 }
 
-inline real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                          VB_LATTICE_PARAMS, global const real* indenters, real t, torus_grip* grip VB_TRI_PARAMS) {
+VB_INLINE real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                             VB_LATTICE_PARAMS, global const real* indenters, real t, torus_grip* grip VB_TRI_PARAMS) {
   return acceleration_from(lattice_force(e, ui, vi, u, v, VB_LATTICE_ARGS), e, ui, vi, VB_LATTICE_ARGS,
                            indenters, t, grip VB_TRI_ARGS);
 }
 
 // Ends a stage: moves an element that ended inside an indenter or a torus tube back onto its
 // surface (indenters first; the obstacle table holds both).
-inline void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_of, int sy, int sz,
-                         real4 origin, real h, global const real* indenters, real t) {
+VB_INLINE void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_of, int sy, int sz,
+                            real4 origin, real h, global const real* indenters, real t) {
 #if VB_INDENTERS || VB_TORI
   const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
 #endif
@@ -52,8 +52,8 @@ inline void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_o
 }
 
 // The end of an explicit stage of free element e once its lattice force f is known.
-inline void explicit_update(uint e, real4* ui, real4* vi, real4 f, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS,
-                            real dt, int symplectic VB_TRI_PARAMS) {
+VB_INLINE void explicit_update(uint e, real4* ui, real4* vi, real4 f, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS,
+                               real dt, int symplectic VB_TRI_PARAMS) {
   torus_grip grip = {0};  // friction of the indenters and tori (no-op without VB_FRICTION)
   real4 a = acceleration_from(f, e, *ui, *vi, VB_LATTICE_ARGS, indenters, t_force, &grip VB_TRI_ARGS);
 #if VB_TORI
@@ -70,8 +70,8 @@ inline void explicit_update(uint e, real4* ui, real4* vi, real4 f, VB_LATTICE_PA
 
 // The corrector's end for free element e once the lattice force f at (ũ, ṽ) is known: returns v',
 // moves ui to u'.
-inline real4 correct_update(uint e, real4* ui, real4 vi, real4 up, real4 vp, real4 f, VB_LATTICE_PARAMS,
-                            VB_INDENTER_PARAMS, real dt VB_TRI_PARAMS) {
+VB_INLINE real4 correct_update(uint e, real4* ui, real4 vi, real4 up, real4 vp, real4 f, VB_LATTICE_PARAMS,
+                               VB_INDENTER_PARAMS, real dt VB_TRI_PARAMS) {
   torus_grip grip = {0};
   real4 a = acceleration_from(f, e, up, vp, VB_LATTICE_ARGS, indenters, t_force, &grip VB_TRI_ARGS);
 #if VB_TORI
@@ -98,8 +98,8 @@ inline real4 correct_update(uint e, real4* ui, real4 vi, real4 up, real4 vp, rea
 inline uint split_element(uint block) { return block * VB_SPLIT_PER + get_local_id(0) % VB_SPLIT_PER; }
 
 // The lattice force on e summed over the parts (in part 0; every work-item of the group must call).
-inline real4 split_lattice_force(int active, uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                                 VB_LATTICE_PARAMS, VB_PENDING_PARAMS, local real4* share) {
+VB_INLINE real4 split_lattice_force(int active, uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                                    VB_LATTICE_PARAMS, VB_PENDING_PARAMS, local real4* share) {
   const uint l = get_local_id(0), part = l / VB_SPLIT_PER;
   real4 f = (real4)(0);
   if (active)
@@ -119,9 +119,9 @@ inline real4 split_lattice_force(int active, uint e, real4 ui, real4 vi, global 
 // Heun's predictor (explicit Euler) moves with the old v. `symplectic` is a constant at each call.
 // (u, v) may have a volume projection pending (kernels/common.cl): the stage starts from the
 // projected state, its own included.
-inline void explicit_stage(uint e, global const real4* u, global const real4* v, global real4* u_out,
-                           global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                           uint n, int symplectic, VB_PENDING_PARAMS VB_TRI_PARAMS) {
+VB_INLINE void explicit_stage(uint e, global const real4* u, global const real4* v, global real4* u_out,
+                              global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
+                              uint n, int symplectic, VB_PENDING_PARAMS VB_TRI_PARAMS) {
   if (e >= n) return;
   real4 ui = u[e], vi = v[e], wg = (real4)(0);
   pending_u(&ui, &wg, e, VB_PENDING_ARGS);
@@ -155,9 +155,9 @@ kernel void euler_step(global const real4* u, global const real4* v, global real
 
 // Heun's predictor for element e (ũ, ṽ into u_pred, v_pred). With VB_SPLIT > 1 every work-item of
 // the group calls it, e = split_element(block), and `share` holds VB_SPLIT_WG real4.
-inline void predict_element(uint e, global const real4* u, global const real4* v, global real4* u_pred,
-                            global real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt, uint n,
-                            VB_PENDING_PARAMS, local real4* share VB_TRI_PARAMS) {
+VB_INLINE void predict_element(uint e, global const real4* u, global const real4* v, global real4* u_pred,
+                               global real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt, uint n,
+                               VB_PENDING_PARAMS, local real4* share VB_TRI_PARAMS) {
 #if VB_SPLIT > 1
   const int in = e < n;
   real4 ui = (real4)(0), vi = (real4)(0), wg = (real4)(0);
@@ -179,10 +179,10 @@ inline void predict_element(uint e, global const real4* u, global const real4* v
 
 // Heun's corrector for element e (u', v' into u, v; the same calling rule as predict_element):
 // `pending` of the state (u, v) for the element's own u, v, and pred_* of the predicted stage.
-inline void correct_element(uint e, global real4* u, global real4* v, global const real4* u_pred,
-                            global const real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt, uint n,
-                            VB_PENDING_PARAMS, global const real4* pred_g, real pred_lambda, real pred_mu,
-                            int pred_pending, local real4* share VB_TRI_PARAMS) {
+VB_INLINE void correct_element(uint e, global real4* u, global real4* v, global const real4* u_pred,
+                               global const real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt, uint n,
+                               VB_PENDING_PARAMS, global const real4* pred_g, real pred_lambda, real pred_mu,
+                               int pred_pending, local real4* share VB_TRI_PARAMS) {
   const int in = e < n;
 #if VB_SPLIT == 1
   if (!in) return;

@@ -37,8 +37,8 @@ inline real spring_end(int law, global const real* mat, real k, real len, real r
 // projection leaves them; ui, vi are the caller's (already projected). Only connections d_lo ≤ d <
 // d_hi are summed (kernels/integrate.cl, VB_SPLIT: parts of an element's connections on several
 // work-items); 0, 26 for all.
-real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                            VB_LATTICE_PARAMS, VB_PENDING_PARAMS, int d_lo, int d_hi) {
+VB_INLINE real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                                      VB_LATTICE_PARAMS, VB_PENDING_PARAMS, int d_lo, int d_hi) {
   const int cell = (int)cell_of[e];
   const real Ei = E[e];
   real4 f = (real4)(0);
@@ -135,8 +135,8 @@ real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, g
   return f;
 }
 
-inline real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                           VB_LATTICE_PARAMS) {
+VB_INLINE real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
+                              VB_LATTICE_PARAMS) {
   return lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_NO_PENDING, 0, 26);
 }
 
