@@ -139,10 +139,11 @@ int run_bench(BenchOptions o) {
     doc["haptic"] = run_haptic_bench(*cl, o);
     write_outputs();
   }
-  if (!o.dry_run && (!o.sizes.empty() || (!o.quick && o.no_study && !o.haptic))) {
+  if (!o.dry_run && (!o.sizes.empty() || o.breast || (!o.quick && o.no_study && !o.haptic))) {
     if (!cl) cl = std::make_unique<ClContext>(device);
     ThroughputOptions t;
-    t.sizes = o.sizes.empty() ? std::vector<int>{33, 115} : o.sizes;  // 35,937 and 1,520,875 elements
+    // 35,937 and 1,520,875 elements unless sizes are given; --breast alone times the breast alone
+    t.sizes = !o.sizes.empty() || o.breast ? o.sizes : std::vector<int>{33, 115};
     t.quick = o.quick;
     t.volume = o.volume;
     t.profile = o.profile;
