@@ -21,9 +21,9 @@ std::string PersistentPlan::options() const {
 PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, bool hyperelastic, std::size_t elements,
                                     int force_split, std::size_t max_elements) {
   PersistentPlan plan;
-  plan.on = eligible && !hyperelastic && nvidia_ptx(device) && elements <= max_elements && device.compute_units > 0;
-  if (const char* env = std::getenv("VOXBREAST_PERSISTENT"))
-    plan.on = eligible && nvidia_ptx(device) && device.compute_units > 0 && std::atoi(env) == 1;
+  const bool possible = eligible && nvidia_ptx(device) && device.compute_units > 0;
+  plan.on = possible && !hyperelastic && elements <= max_elements;
+  if (const char* env = std::getenv("VOXBREAST_PERSISTENT")) plan.on = possible && std::atoi(env) == 1;
   if (!plan.on) return plan;
   constexpr std::size_t kRegistersPerUnit = 65536, kMinPerUnit = 2, kMaxPerUnit = 6;
   const std::size_t per_block = PersistentPlan::kWorkGroup / std::size_t(std::max(force_split, 1));

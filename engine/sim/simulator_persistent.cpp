@@ -1,6 +1,7 @@
 // The persistent Heun step (kernels/persistent.cl): its kernel's arguments, its launches, and the
 // check that its grid barriers never timed out.
 #include <iostream>
+#include <string>
 
 #include "engine/error.hpp"
 #include "engine/sim/simulator.hpp"
@@ -74,6 +75,12 @@ void Simulator::check_grid_barriers() const {
   require(sync[1] == 0,
           "the persistent Heun step's work-groups were not all resident on the device (a grid barrier timed out), "
           "so the state is not valid",
+          "device", "set VOXBREAST_PERSISTENT=0 to step with one launch per pass");
+  // Each launch's targets start from the count the host predicts (enqueue_persistent_step): a
+  // barrier count the host and the kernel disagree on would let groups pass barriers early.
+  require(sync[0] == sync_start_,
+          "the persistent Heun step's barrier count (" + std::to_string(sync[0]) + ") is not the expected " +
+              std::to_string(sync_start_) + ", so its passes may have overlapped and the state is not valid",
           "device", "set VOXBREAST_PERSISTENT=0 to step with one launch per pass");
 }
 
