@@ -269,6 +269,14 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     if (heun_steps && (k == 1 || k == 2 || k == 4)) force_split_ = k;
   }
   options += " -DVB_SPLIT=" + std::to_string(force_split_);
+  // Heun and symplectic Euler on CPUs for plain float spring models: the kernels on scalar
+  // components that PoCL widens across work-items (kernels/integrate_lanes.cl); VOXBREAST_LANES=0
+  // keeps the real4 kernels, to compare.
+  lanes_ = !relax_ && !cl.info.is_gpu && precision_ == Precision::Float && !el.hyperelastic && !el.biphasic &&
+           scene.indenters.empty() && scene.tori.empty() && !tri_contact_ && !(volume_ && volume_launches_ == 0) &&
+           !rest_offsets_ && force_split_ == 1;
+  if (const char* env = std::getenv("VOXBREAST_LANES")) lanes_ = lanes_ && std::atoi(env) != 0;
+  options += " -DVB_LANES=" + std::to_string(lanes_);
   options += " -DVB_NV_PTX=" + std::to_string(nvidia_ptx(cl.info));
   // Heun's whole step in one launch where the device allows it (kernels/persistent.cl): not with
   // triangle contact (its own pass) or folded projections (another way to fewer launches).
@@ -293,7 +301,8 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_TRI_FP64=" + std::to_string(tri_contact_ && cl_.info.fp64);
   // device_contact.cl first: the indenters' friction reuses its grip helpers.
   std::vector<std::string> sources = {"common.cl",         "hyperelastic.cl",     "device_contact.cl",
-                                      "lattice_forces.cl", "triangle_contact.cl", "integrate.cl"};
+                                      "lattice_forces.cl", "triangle_contact.cl", "integrate.cl",
+                                      "integrate_lanes.cl"};
   if (volume_) sources.push_back("volume.cl");
   sources.push_back("persistent.cl");
   if (relax_) sources.push_back("relax.cl");
@@ -308,14 +317,14 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
 
   const bool heun = scene.solver.integrator == Integrator::Heun;
   if (heun) {
-    predict_ = cl::Kernel(program_, "heun_predict");
-    correct_ = cl::Kernel(program_, "heun_correct");
+    predict_ = cl::Kernel(program_, lanes_ ? "heun_predict_lanes" : "heun_predict");
+    correct_ = cl::Kernel(program_, lanes_ ? "heun_correct_lanes" : "heun_correct");
   } else if (relax_) {
     relax_kernel_ = cl::Kernel(program_, "relax_step");
     relax_scale_ = make_real_buffer(relaxation_mass_scale(lattice, el, penalty.row_n_m));
     relax_kernel_.setArg(kStepIndenter + kIndenterArgs + 2, relax_scale_);
   } else {
-    euler_ = cl::Kernel(program_, "euler_step");
+    euler_ = cl::Kernel(program_, lanes_ ? "euler_step_lanes" : "euler_step");
   }
   check_ = cl::Kernel(program_, "check_state");
   for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_}) {
@@ -325,6 +334,9 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     set_real(*k, kStepIndenter + kIndenterArgs, dt_.dt_s);
     k->setArg(kStepIndenter + kIndenterArgs + 1, cl_uint(n_));
   }
+  if (lanes_)  // `one` (kernels/integrate_lanes.cl): 1 at run time, so the compiler cannot pair adjacent loads
+    for (cl::Kernel* k : {&euler_, &predict_, &correct_})
+      if ((*k)()) k->setArg(kStepIndenter + kIndenterArgs + 2, cl_int(1));
   if (heun) {
     predict_.setArg(0, u_); predict_.setArg(1, v_); predict_.setArg(2, u_tmp_); predict_.setArg(3, v_tmp_);
     correct_.setArg(0, u_); correct_.setArg(1, v_); correct_.setArg(2, u_tmp_); correct_.setArg(3, v_tmp_);

@@ -156,6 +156,9 @@ class Simulator {
   /// work-items per element in Heun's force passes (kernels/integrate.cl, VB_SPLIT): 2 on GPUs for
   /// hyperelastic models up to 262,144 elements, else 1; VOXBREAST_FORCE_SPLIT=1|2|4 overrides
   int force_split() const { return force_split_; }
+  /// Heun and symplectic Euler step with the CPU kernels on scalar components
+  /// (kernels/integrate_lanes.cl): CPU devices, plain float spring models; VOXBREAST_LANES=0 turns them off
+  bool lanes() const { return lanes_; }
   /// Heun's whole step runs as one launch (kernels/persistent.cl; NVIDIA GPUs, small models)
   bool persistent_step() const { return persistent_.on; }
 
@@ -259,6 +262,7 @@ class Simulator {
   bool volume_pairs_ = true;  ///< incident triangles as element pairs (VB_VOLUME_PAIRS)
   mutable bool pending_ = false;  ///< (u_, v_) has a projection pending (vol_grad_, vol_scalars_)
   int force_split_ = 1;
+  bool lanes_ = false;  ///< the stepping kernels of kernels/integrate_lanes.cl (VB_LANES)
   cl::NDRange step_global_, step_local_;  ///< Heun's stepping kernels (VB_SPLIT)
   cl::Buffer vol_grad_pred_, vol_scalars_pred_, vol_no_scalars_;
   cl::Kernel vol_pending_;

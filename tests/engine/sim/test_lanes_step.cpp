@@ -1,0 +1,113 @@
+// The CPU stepping kernels on scalar components (kernels/integrate_lanes.cl, VB_LANES) against the
+// real4 kernels they replace on CPUs (kernels/integrate.cl, VOXBREAST_LANES=0). Run where the default
+// device is a CPU (PoCL in CI); on a GPU the lanes form is not used and the comparisons skip.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/sim/simulator.hpp"
+#include "tests/engine/sim/sim_fixtures.hpp"
+#include "tests/engine/sim/trajectory_compare.hpp"
+
+namespace vb {
+namespace {
+
+/// A 10×10×11 block (1,100 elements: not a multiple of any SIMD width, so the vectorised
+/// work-item loops end in their scalar remainder), base held, under gravity, with dashpots and
+/// global damping: every term of the lanes kernels.
+Scene block(bool volume, Integrator integrator = Integrator::Heun) {
+  Scene s = test::box_scene(10, 10, 11, 0.005, 3000);
+  s.anchors.push_back(test::halfspace_anchor("base", Vec3(0, 0, 0.0025), Vec3(0, 0, -1)));
+  s.gravity.active = true;
+  s.gravity.acceleration_m_s2 = Vec3(0, 0, -9.81);
+  s.solver.precision = Precision::Float;
+  s.solver.integrator = integrator;
+  s.solver.dashpot_ratio = 0.1;
+  s.solver.damping_per_s = 5;
+  s.volume.preserve = volume;
+  return s;
+}
+
+std::unique_ptr<Simulator> make_simulator(const Scene& s, const test::Model& m, bool lanes) {
+  setenv("VOXBREAST_LANES", lanes ? "1" : "0", 1);
+  auto sim = std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
+  unsetenv("VOXBREAST_LANES");
+  return sim;
+}
+
+/// u then v after 300 steps from rest, gravity turned after step 100 (a posture change), with
+/// the lanes kernels or the real4 ones; empty when the device does not use the lanes form.
+std::vector<double> run(const Scene& s, bool lanes) {
+  const test::Model m = test::make_model(s);
+  const std::unique_ptr<Simulator> made = make_simulator(s, m, lanes);
+  Simulator& sim = *made;
+  if (sim.lanes() != lanes) return {};
+  for (int k = 0; k < 3; ++k) {
+    sim.advance(100);
+    EXPECT_EQ(sim.check().nonfinite_elements, 0);
+    if (k == 0) sim.set_gravity(Vec3(0, 4.9, -8.5));
+  }
+  std::vector<double> u, v;
+  sim.download(u, v);
+  u.insert(u.end(), v.begin(), v.end());
+  return u;
+}
+
+// The same Heun and symplectic Euler steps as the real4 kernels, term by term: a wrong sign, a
+// missing term (gravity, damping, a dashpot, a connection direction), a held element that moved or
+// a remainder element left out would give another trajectory. The forms differ only where the
+// compiler may fuse a·b + c differently (-cl-mad-enable) in vector and scalar code; on PoCL (AMD
+// EPYC, AVX-512) they agreed exactly; the bound leaves room for other fusing.
+TEST(LanesStep, MatchesReal4Kernels) {
+  for (const Integrator integrator : {Integrator::Heun, Integrator::SymplecticEuler})
+    for (const bool volume : {false, true}) {
+      const std::string name = std::string(integrator == Integrator::Heun ? "Heun" : "symplectic Euler") +
+                               (volume ? " with" : " without") + " the volume constraint";
+      const std::vector<double> lanes = run(block(volume, integrator), true);
+      if (lanes.empty()) GTEST_SKIP() << "the lanes kernels are used on CPU devices only";
+      const double d = test::relative_difference(lanes, run(block(volume, integrator), false));
+      std::cout << name << ": lanes vs real4 kernels, largest difference over largest |u|, |v|: " << d << "\n";
+      EXPECT_LE(d, 1e-5) << name;
+    }
+}
+
+// The lanes form replaces only what it computes: float Heun and symplectic Euler steps of spring models with no contact,
+// device, rest offsets or folded projections. Anything else keeps the real4 kernels.
+TEST(LanesStep, UsedOnlyForPlainFloatSpringModels) {
+  const Scene plain = block(false);
+  const test::Model m = test::make_model(plain);
+  if (!make_simulator(plain, m, true)->lanes()) GTEST_SKIP() << "the lanes kernels are used on CPU devices only";
+  EXPECT_FALSE(make_simulator(plain, m, false)->lanes()) << "VOXBREAST_LANES=0";
+
+  Scene dbl = plain;
+  dbl.solver.precision = Precision::Double;
+  EXPECT_FALSE(make_simulator(dbl, test::make_model(dbl), true)->lanes()) << "double";
+
+  Scene relax = plain;
+  relax.solver.integrator = Integrator::Relaxation;
+  EXPECT_FALSE(make_simulator(relax, test::make_model(relax), true)->lanes()) << "dynamic relaxation";
+
+  Scene ogden = plain;
+  ogden.materials["soft"] = test::validation_material("ogden", 0.45);
+  EXPECT_FALSE(make_simulator(ogden, test::make_model(ogden), true)->lanes()) << "hyperelastic";
+
+  Scene biphasic = plain;
+  biphasic.materials["soft"].law = "biphasic";
+  biphasic.materials["soft"].cubic = 20;
+  biphasic.materials["soft"].critical_strain = 0.1;
+  EXPECT_FALSE(make_simulator(biphasic, test::make_model(biphasic), true)->lanes()) << "biphasic";
+
+  Scene pressed = plain;
+  IndenterSpec sphere;
+  sphere.radius_m = 0.01;
+  sphere.start_m = Vec3(0.025, 0.025, 0.08);
+  pressed.indenters.push_back(sphere);
+  EXPECT_FALSE(make_simulator(pressed, test::make_model(pressed), true)->lanes()) << "indenter";
+}
+
+}  // namespace
+}  // namespace vb
