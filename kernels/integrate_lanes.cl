@@ -105,71 +105,73 @@ VB_INLINE lane3 lane_acceleration(lane3 f, real w, lane3 vi, real4 gravity, real
   return a;
 }
 
-// One explicit stage of element e (integrate.cl, explicit_stage): Heun's predictor ũ = u + dt·v,
-// ṽ = v + dt·a(u, v), or a symplectic Euler step v' = v + dt·a(u, v), u' = u + dt·v'
-// (`symplectic`, a constant at each call). Held elements (w = 0) are copied.
+// The kernels step the free elements only, work-item k the element free_list[k] (n_free of them,
+// ascending): held elements never move, so their entries in both state buffers stay as
+// Simulator::upload wrote them. (A masked branch would not save their work: the vectorised loop
+// computes every lane. On the phantom two thirds of the elements are the rigid chest wall.)
+
+// One explicit stage of a free element (integrate.cl, explicit_stage): Heun's predictor
+// ũ = u + dt·v, ṽ = v + dt·a(u, v), or a symplectic Euler step v' = v + dt·a(u, v), u' = u + dt·v'
+// (`symplectic`, a constant at each call).
 VB_INLINE void lane_explicit_stage(global const real4* u4, global const real4* v4, global real4* u_out,
-                                   global real4* v_out, VB_LATTICE_KERNEL_PARAMS, real dt, uint n, int one,
-                                   int symplectic) {
+                                   global real4* v_out, VB_LATTICE_KERNEL_PARAMS, real dt, uint n_free, int one,
+                                   global const uint* free_list, int symplectic) {
   VB_UNPACK_LATTICE;
-  const uint e = get_global_id(0);
-  if (e >= n) return;
+  const uint k = get_global_id(0);
+  if (k >= n_free) return;
+  const uint e = free_list[k];
   global const real* u = (global const real*)u4;
   global const real* v = (global const real*)v4;
   const lane3 ui = lane_xyz(u, e, one), vi = lane_xyz(v, e, one);
   const real wi = lane_w(u, e, one), vw = lane_w(v, e, one);
-  // Branch-free (a branch stops the vectoriser): held elements compute a force too, not used.
   const lane3 a = lane_acceleration(
       lane_lattice_force(e, ui, wi, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio, one), wi, vi, gravity, damping);
-  const int free = wi != 0;
-  const lane3 vn = {free ? vi.x + dt * a.x : vi.x, free ? vi.y + dt * a.y : vi.y, free ? vi.z + dt * a.z : vi.z};
+  const lane3 vn = {vi.x + dt * a.x, vi.y + dt * a.y, vi.z + dt * a.z};
   const lane3 vm = symplectic ? vn : vi;  // the velocity the element moves with
-  const lane3 un = {free ? ui.x + dt * vm.x : ui.x, free ? ui.y + dt * vm.y : ui.y, free ? ui.z + dt * vm.z : ui.z};
+  const lane3 un = {ui.x + dt * vm.x, ui.y + dt * vm.y, ui.z + dt * vm.z};
   lane_store((global real*)u_out, e, un, wi, one);
   lane_store((global real*)v_out, e, vn, vw, one);
 }
 
 kernel void heun_predict_lanes(global const real4* u, global const real4* v, global real4* u_pred,
-                               global real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt, uint n,
-                               int one) {
+                               global real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
+                               uint n_free, int one, global const uint* free_list) {
   lane_explicit_stage(u, v, u_pred, v_pred, arena, at, sy, sz, h, dashpot_ratio, gravity, damping, origin, hourglass,
-                      dt, n, one, 0);
+                      dt, n_free, one, free_list, 0);
 }
 
 kernel void euler_step_lanes(global const real4* u, global const real4* v, global real4* u_out, global real4* v_out,
-                             VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt, uint n, int one) {
+                             VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt, uint n_free, int one,
+                             global const uint* free_list) {
   lane_explicit_stage(u, v, u_out, v_out, arena, at, sy, sz, h, dashpot_ratio, gravity, damping, origin, hourglass, dt,
-                      n, one, 1);
+                      n_free, one, free_list, 1);
 }
 
 // Heun's corrector: u' = u + dt/2·(v + ṽ), v' = (v + ṽ)/2 + dt/2·a(ũ, ṽ), forces from the predicted
-// stage; held elements keep their state.
+// stage.
 kernel void heun_correct_lanes(global real4* u4, global real4* v4, global const real4* u_pred4,
                                global const real4* v_pred4, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
-                               uint n, int one) {
+                               uint n_free, int one, global const uint* free_list) {
   VB_UNPACK_LATTICE;
-  const uint e = get_global_id(0);
-  if (e >= n) return;
+  const uint k = get_global_id(0);
+  if (k >= n_free) return;
+  const uint e = free_list[k];
   global const real* up_all = (global const real*)u_pred4;
   global const real* vp_all = (global const real*)v_pred4;
   global const real* u = (global const real*)u4;
   global const real* v = (global const real*)v4;
-  const real wi = lane_w(u, e, one), vw = lane_w(v, e, one);
+  const real wi = lane_w(u, e, one);
   const lane3 ui = lane_xyz(u, e, one), vi = lane_xyz(v, e, one);
   const lane3 up = lane_xyz(up_all, e, one), vp = lane_xyz(vp_all, e, one);
   const lane3 a = lane_acceleration(
       lane_lattice_force(e, up, wi, vp, up_all, vp_all, E, cell_of, grid, sy, sz, h, dashpot_ratio, one), wi, vp, gravity,
       damping);
   const real mean = (real)0.5, half_dt = (real)0.5 * dt;
-  // Held elements store what they read (branch-free, as in the predictor).
-  const int free = wi != 0;
-  const lane3 vn = {free ? (vi.x + vp.x) * mean + half_dt * a.x : vi.x,
-                    free ? (vi.y + vp.y) * mean + half_dt * a.y : vi.y,
-                    free ? (vi.z + vp.z) * mean + half_dt * a.z : vi.z};
-  const lane3 un = {free ? ui.x + half_dt * (vi.x + vp.x) : ui.x, free ? ui.y + half_dt * (vi.y + vp.y) : ui.y,
-                    free ? ui.z + half_dt * (vi.z + vp.z) : ui.z};
+  const lane3 vn = {(vi.x + vp.x) * mean + half_dt * a.x, (vi.y + vp.y) * mean + half_dt * a.y,
+                    (vi.z + vp.z) * mean + half_dt * a.z};
+  const lane3 un = {ui.x + half_dt * (vi.x + vp.x), ui.y + half_dt * (vi.y + vp.y), ui.z + half_dt * (vi.z + vp.z)};
   lane_store((global real*)u4, e, un, wi, one);
-  lane_store((global real*)v4, e, vn, free ? 0 : vw, one);
+  lane_store((global real*)v4, e, vn, 0, one);
 }
 
 #endif

@@ -269,10 +269,10 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     if (heun_steps && (k == 1 || k == 2 || k == 4)) force_split_ = k;
   }
   options += " -DVB_SPLIT=" + std::to_string(force_split_);
-  // Heun and symplectic Euler on CPUs for plain float spring models: the kernels on scalar
-  // components that PoCL widens across work-items (kernels/integrate_lanes.cl); VOXBREAST_LANES=0
-  // keeps the real4 kernels, to compare.
-  lanes_ = !relax_ && !cl.info.is_gpu && precision_ == Precision::Float && !el.hyperelastic && !el.biphasic &&
+  // Every integrator on CPUs for plain float spring models: the kernels on scalar components that
+  // PoCL widens across work-items (kernels/integrate_lanes.cl, relax.cl); VOXBREAST_LANES=0 keeps
+  // the real4 kernels, to compare.
+  lanes_ = !cl.info.is_gpu && precision_ == Precision::Float && !el.hyperelastic && !el.biphasic &&
            scene.indenters.empty() && scene.tori.empty() && !tri_contact_ && !(volume_ && volume_launches_ == 0) &&
            !rest_offsets_ && force_split_ == 1;
   if (const char* env = std::getenv("VOXBREAST_LANES")) lanes_ = lanes_ && std::atoi(env) != 0;
@@ -320,7 +320,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     predict_ = cl::Kernel(program_, lanes_ ? "heun_predict_lanes" : "heun_predict");
     correct_ = cl::Kernel(program_, lanes_ ? "heun_correct_lanes" : "heun_correct");
   } else if (relax_) {
-    relax_kernel_ = cl::Kernel(program_, "relax_step");
+    relax_kernel_ = cl::Kernel(program_, lanes_ ? "relax_step_lanes" : "relax_step");
     relax_scale_ = make_real_buffer(relaxation_mass_scale(lattice, el, penalty.row_n_m));
     relax_kernel_.setArg(kStepIndenter + kIndenterArgs + 2, relax_scale_);
   } else {
@@ -334,9 +334,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     set_real(*k, kStepIndenter + kIndenterArgs, dt_.dt_s);
     k->setArg(kStepIndenter + kIndenterArgs + 1, cl_uint(n_));
   }
-  if (lanes_)  // `one` (kernels/integrate_lanes.cl): 1 at run time, so the compiler cannot pair adjacent loads
-    for (cl::Kernel* k : {&euler_, &predict_, &correct_})
-      if ((*k)()) k->setArg(kStepIndenter + kIndenterArgs + 2, cl_int(1));
+  if (lanes_) make_lane_args();
   if (heun) {
     predict_.setArg(0, u_); predict_.setArg(1, v_); predict_.setArg(2, u_tmp_); predict_.setArg(3, v_tmp_);
     correct_.setArg(0, u_); correct_.setArg(1, v_); correct_.setArg(2, u_tmp_); correct_.setArg(3, v_tmp_);
@@ -364,6 +362,30 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   if (tri_contact_) make_triangle_contact_buffers();
   if (persistent_.on) make_persistent_kernel();
   if (rest_offsets_) set_rest_offsets(std::vector<double>(3 * n_, 0.0));  // R₀ = I, J₀ = 1
+}
+
+void Simulator::make_lane_args() {
+  // The lanes kernels step the free elements only (kernels/integrate_lanes.cl), in ascending order.
+  std::vector<cl_uint> free_list;
+  for (std::size_t e = 0; e < n_; ++e)
+    if (inverse_mass_[e] != 0) free_list.push_back(cl_uint(e));
+  const std::size_t n_free = free_list.size();
+  if (free_list.empty()) free_list.push_back(0);  // a placeholder: OpenCL has no empty buffers
+  free_list_ = cl::Buffer(cl_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, free_list.size() * sizeof(cl_uint),
+                          free_list.data());
+  device_bytes_ += free_list.size() * sizeof(cl_uint);
+  const std::size_t wg = kCheckWorkGroup;
+  step_global_ = cl::NDRange(std::max<std::size_t>(1, (n_free + wg - 1) / wg) * wg);
+  // after n: the free count, `one` (1 at run time, so the compiler cannot pair adjacent loads),
+  // the list; relaxation has its scale and damping first
+  for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_}) {
+    if (!(*k)()) continue;
+    const int n_arg = kStepIndenter + kIndenterArgs + 1, extra = k == &relax_kernel_ ? 2 : 0;
+    k->setArg(n_arg, cl_uint(n_free));
+    k->setArg(n_arg + extra + 1, cl_int(1));
+    k->setArg(n_arg + extra + 2, free_list_);
+  }
+  mirror_state();  // upload ran before the lanes were chosen
 }
 
 void Simulator::set_rest_offsets(const std::vector<double>& u0) {
@@ -893,7 +915,7 @@ void Simulator::advance(std::int64_t steps) {
       if (indenter) set_indenter_args(k, kStepIndenter, t0, t1);
       enqueue_stress(u_);
       enqueue_triangle_contact(u_, t0);
-      enqueue(k);
+      launch(k, step_global_, step_local_);
       std::swap(u_, u_tmp_);
       std::swap(v_, v_tmp_);
     }
@@ -1039,6 +1061,12 @@ void Simulator::upload(const std::vector<double>& u, const std::vector<double>& 
     write_xyz<float>(u_, u, &inverse_mass_);
     write_xyz<float>(v_, v, nullptr);
   }
+  if (lanes_) mirror_state();
+}
+
+void Simulator::mirror_state() {
+  cl_.queue.enqueueCopyBuffer(u_, u_tmp_, 0, 0, 4 * real_size_ * n_);
+  cl_.queue.enqueueCopyBuffer(v_, v_tmp_, 0, 0, 4 * real_size_ * n_);
 }
 
 std::vector<double> Simulator::lattice_forces() {

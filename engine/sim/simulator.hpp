@@ -263,6 +263,12 @@ class Simulator {
   mutable bool pending_ = false;  ///< (u_, v_) has a projection pending (vol_grad_, vol_scalars_)
   int force_split_ = 1;
   bool lanes_ = false;  ///< the stepping kernels of kernels/integrate_lanes.cl (VB_LANES)
+  /// the lanes kernels' arguments: the free elements' list (free_list_), their count, `one`
+  void make_lane_args();
+  /// copies (u, v) into the scratch pair (u_tmp_, v_tmp_): the lanes kernels never write held
+  /// elements, so both pairs must hold them (upload, make_lane_args)
+  void mirror_state();
+  cl::Buffer free_list_;
   cl::NDRange step_global_, step_local_;  ///< Heun's stepping kernels (VB_SPLIT)
   cl::Buffer vol_grad_pred_, vol_scalars_pred_, vol_no_scalars_;
   cl::Kernel vol_pending_;
