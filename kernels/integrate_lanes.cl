@@ -112,10 +112,14 @@ VB_INLINE lane3 lane_acceleration(lane3 f, real w, lane3 vi, real4 gravity, real
 
 // One explicit stage of a free element (integrate.cl, explicit_stage): Heun's predictor
 // ũ = u + dt·v, ṽ = v + dt·a(u, v), or a symplectic Euler step v' = v + dt·a(u, v), u' = u + dt·v'
-// (`symplectic`, a constant at each call).
+// (`symplectic`, a constant at each call). With `relax` (a constant too; kernels/relax.cl:
+// dynamic relaxation, symplectic) the acceleration is that of the fictitious dynamics,
+// a·relax_scale − c·v, and v.w is 0 as relax_step stores it. (A branch the compiler cannot
+// resolve, such as one on the pointer, would stop the vectoriser.)
 VB_INLINE void lane_explicit_stage(global const real4* u4, global const real4* v4, global real4* u_out,
                                    global real4* v_out, VB_LATTICE_KERNEL_PARAMS, real dt, uint n_free, int one,
-                                   global const uint* free_list, int symplectic) {
+                                   global const uint* free_list, int symplectic, int relax,
+                                   global const real* relax_scale, real c) {
   VB_UNPACK_LATTICE;
   const uint k = get_global_id(0);
   if (k >= n_free) return;
@@ -124,27 +128,32 @@ VB_INLINE void lane_explicit_stage(global const real4* u4, global const real4* v
   global const real* v = (global const real*)v4;
   const lane3 ui = lane_xyz(u, e, one), vi = lane_xyz(v, e, one);
   const real wi = lane_w(u, e, one), vw = lane_w(v, e, one);
-  const lane3 a = lane_acceleration(
+  lane3 a = lane_acceleration(
       lane_lattice_force(e, ui, wi, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio, one), wi, vi, gravity, damping);
+  if (relax) {
+    const real scale = relax_scale[e];
+    const lane3 fictitious = {a.x * scale - c * vi.x, a.y * scale - c * vi.y, a.z * scale - c * vi.z};
+    a = fictitious;
+  }
   const lane3 vn = {vi.x + dt * a.x, vi.y + dt * a.y, vi.z + dt * a.z};
   const lane3 vm = symplectic ? vn : vi;  // the velocity the element moves with
   const lane3 un = {ui.x + dt * vm.x, ui.y + dt * vm.y, ui.z + dt * vm.z};
   lane_store((global real*)u_out, e, un, wi, one);
-  lane_store((global real*)v_out, e, vn, vw, one);
+  lane_store((global real*)v_out, e, vn, relax ? 0 : vw, one);
 }
 
 kernel void heun_predict_lanes(global const real4* u, global const real4* v, global real4* u_pred,
                                global real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
                                uint n_free, int one, global const uint* free_list) {
   lane_explicit_stage(u, v, u_pred, v_pred, arena, at, sy, sz, h, dashpot_ratio, gravity, damping, origin, hourglass,
-                      dt, n_free, one, free_list, 0);
+                      dt, n_free, one, free_list, 0, 0, 0, 0);
 }
 
 kernel void euler_step_lanes(global const real4* u, global const real4* v, global real4* u_out, global real4* v_out,
                              VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt, uint n_free, int one,
                              global const uint* free_list) {
   lane_explicit_stage(u, v, u_out, v_out, arena, at, sy, sz, h, dashpot_ratio, gravity, damping, origin, hourglass, dt,
-                      n_free, one, free_list, 1);
+                      n_free, one, free_list, 1, 0, 0, 0);
 }
 
 // Heun's corrector: u' = u + dt/2·(v + ṽ), v' = (v + ṽ)/2 + dt/2·a(ũ, ṽ), forces from the predicted

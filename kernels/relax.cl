@@ -35,24 +35,11 @@ kernel void relax_step(global const real4* u, global const real4* v, global real
 #if VB_LANES
 // relax_step on scalar components, for CPUs, over the free elements (kernels/integrate_lanes.cl:
 // why, which scenes, and free_list): the same operations in the same order.
-kernel void relax_step_lanes(global const real4* u4, global const real4* v4, global real4* u_out,
+kernel void relax_step_lanes(global const real4* u, global const real4* v, global real4* u_out,
                              global real4* v_out, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
                              uint n_free, global const real* relax_scale, real c, int one,
                              global const uint* free_list) {
-  VB_UNPACK_LATTICE;
-  const uint k = get_global_id(0);
-  if (k >= n_free) return;
-  const uint e = free_list[k];
-  global const real* u = (global const real*)u4;
-  global const real* v = (global const real*)v4;
-  const lane3 ui = lane_xyz(u, e, one), vi = lane_xyz(v, e, one);
-  const real wi = lane_w(u, e, one), scale = relax_scale[e];
-  const lane3 f = lane_acceleration(
-      lane_lattice_force(e, ui, wi, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio, one), wi, vi, gravity, damping);
-  const lane3 vn = {vi.x + dt * (f.x * scale - c * vi.x), vi.y + dt * (f.y * scale - c * vi.y),
-                    vi.z + dt * (f.z * scale - c * vi.z)};
-  const lane3 un = {ui.x + dt * vn.x, ui.y + dt * vn.y, ui.z + dt * vn.z};
-  lane_store((global real*)u_out, e, un, wi, one);
-  lane_store((global real*)v_out, e, vn, 0, one);
+  lane_explicit_stage(u, v, u_out, v_out, arena, at, sy, sz, h, dashpot_ratio, gravity, damping, origin, hourglass, dt,
+                      n_free, one, free_list, 1, 1, relax_scale, c);
 }
 #endif
