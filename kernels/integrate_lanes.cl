@@ -1,16 +1,16 @@
-// Heun and symplectic Euler steps of spring models on CPUs (VB_LANES, docs/PERF_NOTES.md change
-// 14): the same arithmetic as heun_predict, heun_correct and euler_step (kernels/integrate.cl) on
-// linear springs with gravity, global damping and dashpots, written on scalar components instead
-// of real4.
+// Heun, symplectic Euler and dynamic relaxation (kernels/relax.cl) steps of spring models on CPUs
+// (VB_LANES, docs/PERF_NOTES.md change 14): the same arithmetic as heun_predict, heun_correct,
+// euler_step and relax_step on linear springs with gravity, global damping and dashpots, written
+// on scalar components instead of real4.
 // Why a second form: PoCL runs a work-group as a loop over its work-items and lets LLVM's loop
 // vectoriser widen that loop, one work-item per SIMD lane; LLVM does not widen real4 values
 // ("instruction return type cannot be vectorized"), so the real4 kernels run one element at a time.
-// On scalars LLVM widens the loop 8 work-items wide on AVX2 and AVX-512 CPUs (one vsqrtps per 8
-// square roots, the neighbours' loads gathered). Float only: in double LLVM's cost model declines
-// the gathers, and the scalar form ran slower than the real4 one. Only scenes without indenters,
-// tori, triangle contact, pending volume projections, rest offsets, hyperelastic or biphasic
-// tissue use it (Simulator: lanes_); they are the plain lattice of most positioning and fitting
-// runs.
+// On scalars LLVM widens the loop 8 work-items wide (AVX-512 CPU, 256-bit vectors preferred: one
+// vsqrtps per 8 square roots, the neighbours' loads gathered). Float only: in double LLVM's cost
+// model declines the gathers, and the scalar form ran slower than the real4 one. Only scenes
+// without indenters, tori, triangle contact, pending volume projections, rest offsets,
+// hyperelastic or biphasic tissue use it (Simulator: lanes_); they are the plain lattice of most
+// positioning and fitting runs.
 #if VB_LANES
 
 typedef struct {
@@ -26,11 +26,10 @@ typedef struct {
 #endif
 
 // Element e's (x, y, z) from a real4 array read as reals: scalar loads, which LLVM gathers. `one` is
-// 1, passed at run time (the kernels' last argument): with a constant 1 LLVM's SLP vectoriser,
-// which PoCL runs before the work-item loop vectoriser, pairs the adjacent x and y loads into
-// 2-wide vectors, and a vector-typed value in the loop stops the loop vectoriser (its remark:
-// "instruction return type cannot be vectorized"); with `one` unknown the loads are not adjacent
-// to it.
+// 1, passed at run time (a kernel argument): with a constant 1 LLVM's SLP vectoriser, which PoCL
+// runs before the work-item loop vectoriser, pairs the adjacent x and y loads into 2-wide vectors,
+// and a vector-typed value in the loop stops the loop vectoriser (its remark: "instruction return
+// type cannot be vectorized"); with `one` unknown the compiler cannot tell the loads are adjacent.
 VB_INLINE lane3 lane_xyz(global const real* a, uint e, int one) {
   const lane3 r = {a[4 * e], a[4 * e + one], a[4 * e + 2 * one]};
   return r;

@@ -156,7 +156,7 @@ class Simulator {
   /// work-items per element in Heun's force passes (kernels/integrate.cl, VB_SPLIT): 2 on GPUs for
   /// hyperelastic models up to 262,144 elements, else 1; VOXBREAST_FORCE_SPLIT=1|2|4 overrides
   int force_split() const { return force_split_; }
-  /// Heun and symplectic Euler step with the CPU kernels on scalar components
+  /// every integrator steps with the CPU kernels on scalar components, over the free elements
   /// (kernels/integrate_lanes.cl): CPU devices, plain float spring models; VOXBREAST_LANES=0 turns them off
   bool lanes() const { return lanes_; }
   /// Heun's whole step runs as one launch (kernels/persistent.cl; NVIDIA GPUs, small models)
@@ -269,7 +269,7 @@ class Simulator {
   /// elements, so both pairs must hold them (upload, make_lane_args)
   void mirror_state();
   cl::Buffer free_list_;
-  cl::NDRange step_global_, step_local_;  ///< Heun's stepping kernels (VB_SPLIT)
+  cl::NDRange step_global_, step_local_;  ///< the stepping kernels (Heun's VB_SPLIT; lanes: the free elements)
   cl::Buffer vol_grad_pred_, vol_scalars_pred_, vol_no_scalars_;
   cl::Kernel vol_pending_;
   bool volume_ = false;
