@@ -256,7 +256,8 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                     {"fraction_of_copy_bandwidth", effective / bandwidth},
                     {"device_bytes_per_element", double(sim.device_bytes()) / double(n)},
                     {"volume_launches_per_projection", c.volume ? sim.volume_launches() : 0},
-                    {"force_split", sim.force_split()}, {"persistent_step", sim.persistent_step()}});
+                    {"force_split", sim.force_split()}, {"persistent_step", sim.persistent_step()},
+                    {"lanes_kernels", sim.lanes()}});
     csv << c.name << "," << n << "," << c.law << "," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
         << "\n";

@@ -24,3 +24,14 @@ for r in breast.values():
     assert math.isfinite(rate) and rate > 0, r
 print("breast throughput rows:", {m: round(float(r["steps_per_s"]), 1) for m, r in breast.items()})
 PY
+# On PoCL every row here (float, linear springs, no contact) steps with the kernels CPUs vectorise
+# (kernels/integrate_lanes.cl): a scene feature that silently sent them back to the real4 kernels
+# would cost ~1.7x.
+/usr/bin/python3 - "$work/throughput/bench.json" <<'PY'
+import json, sys
+bench = json.load(open(sys.argv[1]))
+if "Portable Computing Language" in bench["platform"]:
+    rows = bench["throughput"]
+    assert rows and all(r["lanes_kernels"] for r in rows), [(r["model"], r["lanes_kernels"]) for r in rows]
+    print("lanes kernels on PoCL:", sorted({r["model"] for r in rows}))
+PY
