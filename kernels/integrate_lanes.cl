@@ -18,8 +18,11 @@ typedef struct {
 } lane3;
 
 // The square root as LLVM's intrinsic (correctly rounded, as OpenCL's sqrt on PoCL): PoCL's library
-// sqrt is a call it never inlines, and a call stops the vectoriser.
-#if VB_DOUBLE
+// sqrt is a call it never inlines, and a call stops the vectoriser. OpenCL's sqrt for compilers
+// that are not clang-based (no __builtin_sqrtf).
+#if !defined(__clang__)
+#define lane_sqrt sqrt
+#elif VB_DOUBLE
 #define lane_sqrt __builtin_sqrt
 #else
 #define lane_sqrt __builtin_sqrtf
