@@ -88,6 +88,8 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
 #define VB_LATTICE_KERNEL_PARAMS                                                                 \
   global const uchar *arena, uint8 at, int sy, int sz, real h, real dashpot_ratio, real4 gravity, \
       real damping, real4 origin, real hourglass
+// The same parameters passed on by a kernel to a helper that takes VB_LATTICE_KERNEL_PARAMS.
+#define VB_LATTICE_KERNEL_ARGS arena, at, sy, sz, h, dashpot_ratio, gravity, damping, origin, hourglass
 #define VB_UNPACK_LATTICE                                                                \
   global const real* E = (global const real*)VB_ARENA_AT(arena, at.s0);                \
   global const uint* cell_of = (global const uint*)VB_ARENA_AT(arena, at.s1);           \

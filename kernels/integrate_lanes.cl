@@ -147,15 +147,13 @@ VB_INLINE void lane_explicit_stage(global const real4* u4, global const real4* v
 kernel void heun_predict_lanes(global const real4* u, global const real4* v, global real4* u_pred,
                                global real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
                                uint n_free, int one, global const uint* free_list) {
-  lane_explicit_stage(u, v, u_pred, v_pred, arena, at, sy, sz, h, dashpot_ratio, gravity, damping, origin, hourglass,
-                      dt, n_free, one, free_list, 0, 0, 0, 0);
+  lane_explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 0, 0, 0, 0);
 }
 
 kernel void euler_step_lanes(global const real4* u, global const real4* v, global real4* u_out, global real4* v_out,
                              VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt, uint n_free, int one,
                              global const uint* free_list) {
-  lane_explicit_stage(u, v, u_out, v_out, arena, at, sy, sz, h, dashpot_ratio, gravity, damping, origin, hourglass, dt,
-                      n_free, one, free_list, 1, 0, 0, 0);
+  lane_explicit_stage(u, v, u_out, v_out, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 0, 0, 0);
 }
 
 // Heun's corrector: u' = u + dt/2·(v + ṽ), v' = (v + ṽ)/2 + dt/2·a(ũ, ṽ), forces from the predicted
