@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <exception>
+#include <string>
 
 #include "engine/sim/opencl_runtime.hpp"
 
@@ -15,7 +17,7 @@ bool nvidia_ptx(const DeviceInfo& device) {
 std::string PersistentPlan::options() const {
   if (!on) return " -DVB_PERSISTENT=0";
   return " -DVB_PERSISTENT=1 -DVB_PERSISTENT_TRACE=" + std::to_string(trace) +
-         " -cl-nv-maxrregcount=" + std::to_string(max_registers);
+         " -cl-nv-maxrregcount=" + std::to_string(max_registers) + " -cl-nv-verbose";
 }
 
 PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, bool hyperelastic, std::size_t elements,
@@ -39,6 +41,27 @@ PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, boo
     plan.groups = std::clamp<std::size_t>(std::size_t(std::max(std::atoi(env), 1)), 1, plan.groups);
   plan.max_registers = int(std::min<std::size_t>(255, kRegistersPerUnit / (PersistentPlan::kWorkGroup * per_unit) / 8 * 8));
   return plan;
+}
+
+int registers_in_build_log(const std::string& log, const std::string& kernel) {
+  const std::size_t entry = log.find("Compiling entry function '" + kernel + "'");
+  if (entry == std::string::npos) return -1;
+  const std::size_t next = log.find("Compiling entry function", entry + 1);
+  const std::size_t used = log.find("Used ", entry);
+  if (used == std::string::npos || used > next) return -1;
+  const std::size_t end = log.find(" registers", used);
+  if (end == std::string::npos || end > next) return -1;
+  try {
+    return std::stoi(log.substr(used + 5, end - used - 5));
+  } catch (const std::exception&) {
+    return -1;
+  }
+}
+
+std::size_t groups_per_unit_by_registers(int registers, std::size_t work_group) {
+  constexpr std::size_t kRegistersPerUnit = 65536;
+  const std::size_t per_item = (std::size_t(std::max(registers, 1)) + 7) / 8 * 8;
+  return kRegistersPerUnit / (per_item * work_group);
 }
 
 }  // namespace vb

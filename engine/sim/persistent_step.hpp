@@ -17,7 +17,8 @@ struct PersistentPlan {
   int max_registers = 0;    ///< per work-item, so that groups / compute units fit on one
   bool trace = false;       ///< VOXBREAST_PERSISTENT_TRACE=1: pass times printed at each check
   static constexpr std::size_t kWorkGroup = 128;  ///< VB_PERSISTENT_WG
-  /// build options: -DVB_PERSISTENT=0|1 and, when on, NVIDIA's register cap
+  /// build options: -DVB_PERSISTENT=0|1 and, when on, NVIDIA's register cap and -cl-nv-verbose (the
+  /// build log then says how many registers the kernel uses: registers_in_build_log)
   std::string options() const;
 };
 
@@ -31,5 +32,14 @@ struct PersistentPlan {
 /// groups in all, so that tests make each group walk several blocks.
 PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, bool hyperelastic, std::size_t elements,
                                     int force_split, std::size_t max_elements);
+
+/// The registers per work-item that NVIDIA's compiler reports for `kernel` in a build log made
+/// with -cl-nv-verbose ("Compiling entry function 'kernel'", then "Used N registers"); -1 where
+/// the log does not say.
+int registers_in_build_log(const std::string& log, const std::string& kernel);
+
+/// Work-groups of `work_group` work-items using `registers` registers each that one NVIDIA compute
+/// unit holds at once (65,536 registers, allocated per warp in multiples of 8 per work-item).
+std::size_t groups_per_unit_by_registers(int registers, std::size_t work_group);
 
 }  // namespace vb

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/sim/persistent_step.hpp"
 #include "engine/sim/simulator.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
 #include "tests/engine/sim/trajectory_compare.hpp"
@@ -94,6 +95,36 @@ TEST(PersistentStep, MatchesWithEveryForceSplitAndFewGroups) {
     if (one.empty()) GTEST_SKIP() << "no persistent step on this device (NVIDIA GPUs only)";
     EXPECT_LE(test::relative_difference(one, run_case(Case::OgdenVolumeEveryThird, false, split)), 1e-12) << split;
   }
+}
+
+// The groups launched must all be resident: NVIDIA's compiler can use more registers than the
+// plan's cap (96 against 80 for the double step at 125k elements, where 6 planned groups per
+// compute unit did not fit and the grid barrier timed out), so the simulator reads the registers
+// from the build log (ptxas's own lines, as NVIDIA's OpenCL 3.0 driver 580 writes them) and
+// launches no more groups than fit. Host-only: runs everywhere.
+TEST(PersistentStep, GroupsFitTheRegistersTheBuildLogReports) {
+  const std::string log =
+      "ptxas info    : Compiling entry function 'heun_predict' for 'sm_90a'\n"
+      "ptxas info    : Function properties for heun_predict\n"
+      "ptxas         .     0 bytes stack frame, 0 bytes spill stores, 0 bytes spill loads\n"
+      "ptxas info    : Used 56 registers, used 1 barriers, 3076 bytes smem\n"
+      "ptxas info    : Compiling entry function 'check_state' for 'sm_90a'\n"
+      "ptxas info    : Function properties for check_state\n"
+      "ptxas info    : Compiling entry function 'heun_step_persistent' for 'sm_90a'\n"
+      "ptxas info    : Function properties for heun_step_persistent\n"
+      "ptxas         .     0 bytes stack frame, 0 bytes spill stores, 0 bytes spill loads\n"
+      "ptxas info    : Used 96 registers, used 1 barriers\n";
+  EXPECT_EQ(registers_in_build_log(log, "heun_step_persistent"), 96);
+  EXPECT_EQ(registers_in_build_log(log, "heun_predict"), 56);
+  EXPECT_EQ(registers_in_build_log(log, "check_state"), -1) << "its entry has no Used line before the next entry";
+  EXPECT_EQ(registers_in_build_log(log, "heun_correct"), -1);
+  EXPECT_EQ(registers_in_build_log("", "heun_step_persistent"), -1);
+
+  EXPECT_EQ(groups_per_unit_by_registers(64, 128), 8u);
+  EXPECT_EQ(groups_per_unit_by_registers(80, 128), 6u);
+  EXPECT_EQ(groups_per_unit_by_registers(96, 128), 5u);  // the double step that timed out with 6
+  EXPECT_EQ(groups_per_unit_by_registers(81, 128), 5u);  // allocated as 88
+  EXPECT_EQ(groups_per_unit_by_registers(255, 128), 2u);
 }
 
 }  // namespace
