@@ -1,6 +1,7 @@
 // Heun's whole step as one launch with grid barriers (kernels/persistent.cl) against one launch per
 // pass. Runs on NVIDIA GPUs only (VOXBREAST_DEVICE=gpu, scripts/perf_gpu.sh); elsewhere the
-// persistent step is not offered and the tests skip.
+// persistent step is not offered and those tests skip. The launch's group count from the build
+// log is checked on the host, everywhere.
 #include <gtest/gtest.h>
 
 #include <algorithm>
