@@ -20,6 +20,11 @@ std::string PersistentPlan::options() const {
          " -cl-nv-maxrregcount=" + std::to_string(max_registers) + " -cl-nv-verbose";
 }
 
+void PersistentPlan::fit_registers(int registers, std::size_t compute_units) {
+  if (!on || registers <= 0) return;
+  groups = std::min(groups, std::max<std::size_t>(1, groups_per_unit_by_registers(registers, kWorkGroup) * compute_units));
+}
+
 PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, bool hyperelastic, std::size_t elements,
                                     int force_split, std::size_t max_elements) {
   PersistentPlan plan;

@@ -13,13 +13,17 @@ bool nvidia_ptx(const DeviceInfo& device);
 
 struct PersistentPlan {
   bool on = false;
-  std::size_t groups = 0;   ///< work-groups of kWorkGroup work-items, all resident
+  std::size_t groups = 0;   ///< work-groups of kWorkGroup work-items, all resident (fit_registers)
   int max_registers = 0;    ///< per work-item, so that groups / compute units fit on one
   bool trace = false;       ///< VOXBREAST_PERSISTENT_TRACE=1: pass times printed at each check
   static constexpr std::size_t kWorkGroup = 128;  ///< VB_PERSISTENT_WG
   /// build options: -DVB_PERSISTENT=0|1 and, when on, NVIDIA's register cap and -cl-nv-verbose (the
   /// build log then says how many registers the kernel uses: registers_in_build_log)
   std::string options() const;
+  /// Lowers `groups` to what `compute_units` hold when the built kernel uses `registers` per
+  /// work-item (registers_in_build_log; ≤ 0: unknown, the plan stays): NVIDIA's compiler may exceed
+  /// the cap (96 against 80 for the double step), and a group that never starts stalls the barriers.
+  void fit_registers(int registers, std::size_t compute_units);
 };
 
 /// Heun scenes without triangle contact or folded volume projections, on an NVIDIA GPU: by default
@@ -27,7 +31,8 @@ struct PersistentPlan {
 /// for hyperelastic models, where it measured slower: docs/PERF_NOTES.md change 12). Groups per
 /// compute unit: enough for one block of elements per group in the widest pass (force_split
 /// work-items per element), 2 to 6; the register cap 65,536 / (128 · groups per unit), in
-/// multiples of 8, is what NVIDIA's register file then lets reside. VOXBREAST_PERSISTENT_GROUPS=k
+/// multiples of 8, is what NVIDIA's register file then lets reside if the compiler keeps to it
+/// (after the build: PersistentPlan::fit_registers). VOXBREAST_PERSISTENT_GROUPS=k
 /// sets the groups per compute unit (1–8), to compare; VOXBREAST_PERSISTENT_GROUP_LIMIT=N at most N
 /// groups in all, so that tests make each group walk several blocks.
 PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, bool hyperelastic, std::size_t elements,

@@ -1,6 +1,5 @@
 // The persistent Heun step (kernels/persistent.cl): its kernel's arguments, its launches, and the
 // check that its grid barriers never timed out.
-#include <algorithm>
 #include <iostream>
 #include <string>
 
@@ -23,17 +22,11 @@ constexpr int sync_arg(bool volume) { return volume ? kProject + 1 : kMesh; }
 
 void Simulator::make_persistent_kernel() {
   cl::Kernel& k = persistent_kernel_ = cl::Kernel(program_, "heun_step_persistent");
-  // Every group must be resident at once. The plan's register cap is meant to make them fit, but
-  // NVIDIA's compiler may use more than the cap asks: in double at 125k elements, 96 registers
-  // against a cap of 80, so 5 groups of the planned 6 per compute unit fitted and the grid
-  // barrier timed out. The build log says what the kernel uses: launch no more groups than fit.
-  const int registers =
-      registers_in_build_log(program_.getBuildInfo<CL_PROGRAM_BUILD_LOG>(cl_.info.device), "heun_step_persistent");
-  if (registers > 0) {
-    const std::size_t fit =
-        groups_per_unit_by_registers(registers, PersistentPlan::kWorkGroup) * std::size_t(cl_.info.compute_units);
-    persistent_.groups = std::min(persistent_.groups, std::max<std::size_t>(fit, 1));
-  }
+  // Every group must be resident at once: the build log says how many registers the kernel
+  // really uses (docs/PERF_NOTES.md, "A GPU-only failure of the one-launch step in double").
+  persistent_.fit_registers(
+      registers_in_build_log(program_.getBuildInfo<CL_PROGRAM_BUILD_LOG>(cl_.info.device), "heun_step_persistent"),
+      cl_.info.compute_units);
   k.setArg(0, u_);
   k.setArg(1, v_);
   k.setArg(2, u_tmp_);

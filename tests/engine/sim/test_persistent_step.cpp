@@ -126,6 +126,17 @@ TEST(PersistentStep, GroupsFitTheRegistersTheBuildLogReports) {
   EXPECT_EQ(groups_per_unit_by_registers(96, 128), 5u);  // the double step that timed out with 6
   EXPECT_EQ(groups_per_unit_by_registers(81, 128), 5u);  // allocated as 88
   EXPECT_EQ(groups_per_unit_by_registers(255, 128), 2u);
+
+  // the H200's 132 compute units, 6 groups per unit planned (125k elements)
+  PersistentPlan plan;
+  plan.on = true;
+  plan.groups = 792;
+  plan.fit_registers(64, 132);
+  EXPECT_EQ(plan.groups, 792u) << "within the cap: the plan stays";
+  plan.fit_registers(-1, 132);
+  EXPECT_EQ(plan.groups, 792u) << "a log without the line: the plan stays";
+  plan.fit_registers(96, 132);
+  EXPECT_EQ(plan.groups, 660u) << "96 registers: 5 groups per unit";
 }
 
 }  // namespace
