@@ -159,6 +159,48 @@ double heun_bytes_per_element(std::size_t real_size, const std::string& law) {
   return springs + 2 * stress_pass;
 }
 
+/// Device time per step with the host ahead of the device (s), and whether the host stayed ahead.
+struct DeviceAlone {
+  double seconds_per_step = 0;
+  bool host_ahead = false;
+};
+
+/// The device's own time per step: a kernel holds the queue while the host enqueues `steps` steps
+/// behind it, so the time to the end of the queue less the holding kernel's own time is the steps'
+/// device time, however slow the host's launches are. (A profiling queue cannot tell: on NVIDIA
+/// its events slow the device as well.) If the host had not finished enqueueing when the holding
+/// kernel ended, the time includes waits for the host and is only an upper bound.
+DeviceAlone device_time_per_step(const ClContext& cl, Simulator& sim, std::int64_t steps) {
+  cl::Program p = build_program(cl, {"common.cl", "bandwidth.cl"}, "", "-DVB_DOUBLE=0");
+  cl::Kernel hold(p, "hold_queue");
+  cl::Buffer scratch(cl.context, CL_MEM_READ_WRITE, 128 * sizeof(float));
+  cl.queue.enqueueFillBuffer(scratch, cl_float(0), 0, 128 * sizeof(float));
+  hold.setArg(0, scratch);
+  const cl::NDRange group(128);
+  const auto hold_alone = [&] {
+    cl.queue.finish();
+    const auto t0 = std::chrono::steady_clock::now();
+    cl.queue.enqueueNDRangeKernel(hold, cl::NullRange, group, group);
+    cl.queue.finish();
+    return seconds_since(t0);
+  };
+  const cl_uint probe = 1u << 16;
+  hold.setArg(1, probe);
+  hold_alone();  // the first launch may compile
+  const double per_iteration = hold_alone() / double(probe);
+  // three times the host's enqueue time of the batch, and at least 10 ms
+  const double wanted_s = 3 * host_enqueue_per_step(sim) * double(steps) + 0.01;
+  hold.setArg(1, cl_uint(std::min(4.0e9, wanted_s / std::max(per_iteration, 1e-12))));
+  const double held_s = 0.5 * (hold_alone() + hold_alone());
+  cl.queue.finish();
+  const auto t0 = std::chrono::steady_clock::now();
+  cl.queue.enqueueNDRangeKernel(hold, cl::NullRange, group, group);
+  sim.advance(steps);
+  const double enqueued_s = seconds_since(t0);
+  cl.queue.finish();
+  return {(seconds_since(t0) - held_s) / double(steps), enqueued_s < held_s};
+}
+
 /// Device time per kernel over about 0.2 s of steps of the same model on a profiling queue. On
 /// NVIDIA the profiling events make the host the bottleneck, so the profiled step is slower than
 /// the timed one; the per-kernel times remain device times.
@@ -251,21 +293,34 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     std::printf("%-12s %9zu elements  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
                 c.name.c_str(), n, c.law.c_str(), integ, prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
     std::fflush(stdout);
-    rows.push_back({{"model", c.name}, {"elements", n}, {"law", c.law}, {"integrator", integ}, {"precision", prec},
-                    {"steps_per_s", sps}, {"bytes_per_element_step", bytes}, {"effective_bandwidth_gb_s", effective / 1e9},
-                    {"fraction_of_copy_bandwidth", effective / bandwidth},
-                    {"device_bytes_per_element", double(sim.device_bytes()) / double(n)},
-                    {"volume_launches_per_projection", c.volume ? sim.volume_launches() : 0},
-                    {"force_split", sim.force_split()}, {"persistent_step", sim.persistent_step()},
-                    {"lanes_kernels", sim.lanes()}});
+    nlohmann::json row = {{"model", c.name}, {"elements", n}, {"law", c.law}, {"integrator", integ}, {"precision", prec},
+                          {"steps_per_s", sps}, {"bytes_per_element_step", bytes}, {"effective_bandwidth_gb_s", effective / 1e9},
+                          {"fraction_of_copy_bandwidth", effective / bandwidth},
+                          {"device_bytes_per_element", double(sim.device_bytes()) / double(n)},
+                          {"volume_launches_per_projection", c.volume ? sim.volume_launches() : 0},
+                          {"force_split", sim.force_split()}, {"persistent_step", sim.persistent_step()},
+                          {"lanes_kernels", sim.lanes()}};
     csv << c.name << "," << n << "," << c.law << "," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
         << "\n";
     if (o.profile) {
-      std::printf("    host enqueue %.2f us/step (16-step batch, timed queue) of %.2f us/step timed\n",
-                  1e6 * host_enqueue_per_step(sim), 1e6 / sps);
+      // Which side sets the pace: the host's launches (enqueue time close to the step) or the
+      // device (its time alone close to the step).
+      const double host_s = host_enqueue_per_step(sim);
+      // 64 steps of at most 8 launches: NVIDIA's queue takes 512 without blocking the host (it
+      // blocks somewhere between 512 and 2,048)
+      const std::int64_t held_steps = 64;
+      const DeviceAlone device = device_time_per_step(cl, sim, held_steps);
+      std::printf("    host enqueue %.2f us/step (16-step batch), device alone %.2f us/step (%lld steps behind a held queue%s), "
+                  "timed %.2f us/step\n",
+                  1e6 * host_s, 1e6 * device.seconds_per_step, (long long)held_steps,
+                  device.host_ahead ? "" : "; the host fell behind: an upper bound", 1e6 / sps);
+      row["host_enqueue_us_per_step"] = 1e6 * host_s;
+      row["device_alone_us_per_step"] = 1e6 * device.seconds_per_step;
+      row["device_alone_host_ahead"] = device.host_ahead;
       print_kernel_profile(cl, scene, lattice, el, sps);
     }
+    rows.push_back(row);
   }
   result.rows = rows;
   result.csv = csv.str();

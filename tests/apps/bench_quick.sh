@@ -35,3 +35,19 @@ if "Portable Computing Language" in bench["platform"]:
     assert rows and all(r["lanes_kernels"] for r in rows), [(r["model"], r["lanes_kernels"]) for r in rows]
     print("lanes kernels on PoCL:", sorted({r["model"] for r in rows}))
 PY
+
+# --profile: which side sets the pace. The device's time alone (steps queued behind a held queue)
+# must be a real step time: positive, and on a device-bound run (PoCL) close to the timed step.
+"$bin" bench --quick --no-study --sizes 8 --laws linear --volume --profile --out "$work/profile" >"$work/profile.log"
+/usr/bin/python3 - "$work/profile/bench.json" <<'PY'
+import json, math, sys
+rows = json.load(open(sys.argv[1]))["throughput"]
+assert rows, "no throughput rows"
+for r in rows:
+    device, host = r["device_alone_us_per_step"], r["host_enqueue_us_per_step"]
+    timed = 1e6 / r["steps_per_s"]
+    assert math.isfinite(device) and device > 0 and math.isfinite(host) and host > 0, r
+    if r["device_alone_host_ahead"]:
+        assert timed / 3 < device < 3 * timed, (r["model"], device, timed)
+    print(f'{r["model"]}: device alone {device:.1f} us/step, host enqueue {host:.1f}, timed {timed:.1f}')
+PY
