@@ -225,8 +225,10 @@ Command add_bench(CLI::App& app) {
   sub->add_flag("--breast", o->breast,
                 "throughput: also time the breast phantom resampled to ~36k elements (models breast, breast_volume)");
   sub->add_flag("--volume", o->volume, "throughput: also time each law with [volume] preserve = true (model block_volume)");
-  sub->add_flag("--profile", o->profile, "throughput: print the device time and launches per step of each kernel "
-                                         "(a second run of each block on a profiling queue)");
+  sub->add_flag("--profile", o->profile, "throughput: print whether the host or the device sets the pace (host "
+                                         "enqueue time, the device's time alone, the timed step) and the device time "
+                                         "and launches per step of each kernel (a second run of each block on a "
+                                         "profiling queue)");
   sub->add_flag("--dry-run", o->dry_run, "list the scenes and cases without running them");
   sub->add_flag("--haptic", o->haptic, "haptic rate: a probe pressing a block, force output at 1 kHz (with "
                                        "--no-study: only this)");
