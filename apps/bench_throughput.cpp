@@ -166,11 +166,11 @@ struct DeviceAlone {
 };
 
 /// The device's own time per step: a kernel holds the queue while the host enqueues `steps` steps
-/// behind it, so the time to the end of the queue less the holding kernel's own time is the steps'
+/// (about `host_s_per_step` each, host_enqueue_per_step) behind it, so the time to the end of the queue less the holding kernel's own time is the steps'
 /// device time, however slow the host's launches are. (A profiling queue cannot tell: on NVIDIA
 /// its events slow the device as well.) If the host had not finished enqueueing when the holding
 /// kernel ended, the time includes waits for the host and is only an upper bound.
-DeviceAlone device_time_per_step(const ClContext& cl, Simulator& sim, std::int64_t steps) {
+DeviceAlone device_time_per_step(const ClContext& cl, Simulator& sim, std::int64_t steps, double host_s_per_step) {
   cl::Program p = build_program(cl, {"common.cl", "bandwidth.cl"}, "", "-DVB_DOUBLE=0");
   cl::Kernel hold(p, "hold_queue");
   cl::Buffer scratch(cl.context, CL_MEM_READ_WRITE, 128 * sizeof(float));
@@ -189,7 +189,7 @@ DeviceAlone device_time_per_step(const ClContext& cl, Simulator& sim, std::int64
   hold_alone();  // the first launch may compile
   const double per_iteration = hold_alone() / double(probe);
   // three times the host's enqueue time of the batch, and at least 10 ms
-  const double wanted_s = 3 * host_enqueue_per_step(sim) * double(steps) + 0.01;
+  const double wanted_s = 3 * host_s_per_step * double(steps) + 0.01;
   hold.setArg(1, cl_uint(std::min(4.0e9, wanted_s / std::max(per_iteration, 1e-12))));
   const double held_s = 0.5 * (hold_alone() + hold_alone());
   cl.queue.finish();
@@ -310,7 +310,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
       // 64 steps of at most 8 launches: NVIDIA's queue takes 512 without blocking the host (it
       // blocks somewhere between 512 and 2,048)
       const std::int64_t held_steps = 64;
-      const DeviceAlone device = device_time_per_step(cl, sim, held_steps);
+      const DeviceAlone device = device_time_per_step(cl, sim, held_steps, host_s);
       std::printf("    host enqueue %.2f us/step (16-step batch), device alone %.2f us/step (%lld steps behind a held queue%s), "
                   "timed %.2f us/step\n",
                   1e6 * host_s, 1e6 * device.seconds_per_step, (long long)held_steps,

@@ -8,6 +8,9 @@
 #include "engine/sim/opencl_runtime.hpp"
 
 namespace vb {
+namespace {
+constexpr std::size_t kRegistersPerUnit = 65536;  // an NVIDIA compute unit's register file
+}  // namespace
 
 bool nvidia_ptx(const DeviceInfo& device) {
   return device.is_gpu && (device.platform.find("NVIDIA") != std::string::npos ||
@@ -32,7 +35,7 @@ PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, boo
   plan.on = possible && !hyperelastic && elements <= max_elements;
   if (const char* env = std::getenv("VOXBREAST_PERSISTENT")) plan.on = possible && std::atoi(env) == 1;
   if (!plan.on) return plan;
-  constexpr std::size_t kRegistersPerUnit = 65536, kMinPerUnit = 2, kMaxPerUnit = 6;
+  constexpr std::size_t kMinPerUnit = 2, kMaxPerUnit = 6;
   const std::size_t per_block = PersistentPlan::kWorkGroup / std::size_t(std::max(force_split, 1));
   const std::size_t blocks = (elements + per_block - 1) / per_block;
   std::size_t per_unit =
@@ -64,7 +67,6 @@ int registers_in_build_log(const std::string& log, const std::string& kernel) {
 }
 
 std::size_t groups_per_unit_by_registers(int registers, std::size_t work_group) {
-  constexpr std::size_t kRegistersPerUnit = 65536;
   const std::size_t per_item = (std::size_t(std::max(registers, 1)) + 7) / 8 * 8;
   return kRegistersPerUnit / (per_item * work_group);
 }
