@@ -903,11 +903,15 @@ StopSpec read_stop(const Section& s) {
   return stop;
 }
 
+const NameTable<VolumeSpec::Predictor> kVolumePredictors = {{"pressure", VolumeSpec::Predictor::Pressure, {}},
+                                                              {"projection", VolumeSpec::Predictor::Projection, {}}};
+
 VolumeSpec read_volume(const Section& s) {
-  s.check_keys({"preserve", "every"});
+  s.check_keys({"preserve", "every", "predictor"});
   VolumeSpec volume;
   volume.preserve = s.boolean("preserve").value_or(volume.preserve);
   volume.every = s.integer<int>("every", 1).value_or(volume.every);
+  if (const auto* n = s.named("predictor", kVolumePredictors)) volume.predictor = n->value;
   volume.line = s.line();
   return volume;
 }

@@ -7,6 +7,25 @@
 //     corrector u' = u + dt/2·(v + ṽ), v' = v + dt/2·(a(u, v) + a(ũ, ṽ)) = (v + ṽ)/2 + dt/2·a(ũ, ṽ)
 //     (a(u, v) is recovered from ṽ, so no force buffer is stored).
 
+// Heun's predicted stage under the volume constraint's lagged pressure (VB_VOLUME_LAG; Simulator:
+// volume_lag_; docs/PHYSICS.md, "Volume preservation"): instead of a projection of its own, the
+// stage feels the force −(M/dt)·g on each free surface element, g the volume gradient and M the
+// multiplier the last corrections left (kernels/volume.cl: M ← μ + M/2), so at a constrained
+// equilibrium ṽ = v + dt·w·(f − p·g) = 0, as with the projection. lag_force is that force; with
+// `lag` 0 (a constant at each call) it is zero and costs nothing.
+#define VB_LAG_PARAMS int lag, global const real4 *lag_g, real lag_p
+#define VB_LAG_ARGS lag, lag_g, lag_p
+#define VB_NO_LAG 0, (global const real4*)0, (real)0
+VB_INLINE real4 lag_force(uint e, VB_LAG_PARAMS) { return lag ? lag_p * lag_g[e] : (real4)(0); }
+// heun_predict's own arguments: the gradient and the volume scalars {λ, μ, V, p, M}.
+#if VB_VOLUME_LAG
+#define VB_LAG_KERNEL_PARAMS , global const real4 *lag_g, global const real *lag_scalars
+#define VB_LAG_KERNEL_ARGS 1, lag_g, lag_scalars[4] / dt
+#else
+#define VB_LAG_KERNEL_PARAMS
+#define VB_LAG_KERNEL_ARGS VB_NO_LAG
+#endif
+
 // Acceleration of free element e from its lattice force f (N): gravity, global damping and the
 // indenters' constraint added as static_force and acceleration add them.
 // `grip` collects the indenters' friction (device_contact.cl), turned into m/s² like the torus's.
@@ -121,13 +140,14 @@ VB_INLINE real4 split_lattice_force(int active, uint e, real4 ui, real4 vi, glob
 // projected state, its own included.
 VB_INLINE void explicit_stage(uint e, global const real4* u, global const real4* v, global real4* u_out,
                               global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                              uint n, int symplectic, VB_PENDING_PARAMS VB_TRI_PARAMS) {
+                              uint n, int symplectic, VB_PENDING_PARAMS, VB_LAG_PARAMS VB_TRI_PARAMS) {
   if (e >= n) return;
   real4 ui = u[e], vi = v[e], wg = (real4)(0);
   pending_u(&ui, &wg, e, VB_PENDING_ARGS);
   pending_v(&vi, wg, VB_PENDING_ARGS);
   if (ui.w != 0) {
-    const real4 f = lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, 0, 26);
+    const real4 f = lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, 0, 26) -
+                    lag_force(e, VB_LAG_ARGS);
     explicit_update(e, &ui, &vi, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, symplectic VB_TRI_ARGS);
   }
   u_out[e] = ui;
@@ -138,7 +158,8 @@ kernel void euler_step(global const real4* u, global const real4* v, global real
                        global real4* v_out, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
                        uint n VB_TRI_PARAMS) {
   VB_UNPACK_LATTICE;
-  explicit_stage(get_global_id(0), u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1, VB_NO_PENDING VB_TRI_ARGS);
+  explicit_stage(get_global_id(0), u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1, VB_NO_PENDING,
+                 VB_NO_LAG VB_TRI_ARGS);
 }
 
 // With VB_VOLUME_FOLD (Heun with the volume constraint, kernels/volume.cl: volume_pending) the
@@ -157,7 +178,7 @@ kernel void euler_step(global const real4* u, global const real4* v, global real
 // the group calls it, e = split_element(block), and `share` holds VB_SPLIT_WG real4.
 VB_INLINE void predict_element(uint e, global const real4* u, global const real4* v, global real4* u_pred,
                                global real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt, uint n,
-                               VB_PENDING_PARAMS, local real4* share VB_TRI_PARAMS) {
+                               VB_PENDING_PARAMS, VB_LAG_PARAMS, local real4* share VB_TRI_PARAMS) {
 #if VB_SPLIT > 1
   const int in = e < n;
   real4 ui = (real4)(0), vi = (real4)(0), wg = (real4)(0);
@@ -169,11 +190,13 @@ VB_INLINE void predict_element(uint e, global const real4* u, global const real4
   }
   const real4 f = split_lattice_force(in && ui.w != 0, e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, share);
   if (!in || get_local_id(0) >= VB_SPLIT_PER) return;
-  if (ui.w != 0) explicit_update(e, &ui, &vi, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, 0 VB_TRI_ARGS);
+  if (ui.w != 0)
+    explicit_update(e, &ui, &vi, f - lag_force(e, VB_LAG_ARGS), VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, 0 VB_TRI_ARGS);
   u_pred[e] = ui;
   v_pred[e] = vi;
 #else
-  explicit_stage(e, u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0, VB_PENDING_ARGS VB_TRI_ARGS);
+  explicit_stage(e, u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0, VB_PENDING_ARGS, VB_LAG_ARGS
+                 VB_TRI_ARGS);
 #endif
 }
 
@@ -223,11 +246,11 @@ VB_INLINE void correct_element(uint e, global real4* u, global real4* v, global 
 
 kernel VB_STEP_ATTR void heun_predict(global const real4* u, global const real4* v, global real4* u_pred,
                                       global real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
-                                      uint n VB_FOLD_PARAMS(state) VB_TRI_PARAMS) {
+                                      uint n VB_FOLD_PARAMS(state) VB_LAG_KERNEL_PARAMS VB_TRI_PARAMS) {
   VB_UNPACK_LATTICE;
   VB_STEP_SHARE;
   predict_element(VB_STEP_ELEMENT, u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n,
-                  VB_FOLD_PENDING(state), share VB_TRI_ARGS);
+                  VB_FOLD_PENDING(state), VB_LAG_KERNEL_ARGS, share VB_TRI_ARGS);
 }
 
 kernel VB_STEP_ATTR void heun_correct(global real4* u, global real4* v, global const real4* u_pred,

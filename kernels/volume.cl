@@ -11,6 +11,10 @@
 //   and g = ∂V/∂x of every surface element into `grad` (indexed by element).
 //   volume_finish: one work-group; scalars = {λ, μ, V, p}: λ = (V0 − V)/Σw|g|², μ = Σg·v/Σw|g|²,
 //     p = Σg·f/Σ|g|² (the pressure the check subtracts from the residual).
+//   With VB_VOLUME_LAG (Heun; kernels/integrate.cl, lag_force) the corrections (volume_apply,
+//     volume_project) also update scalars[4], the multiplier M ← μ + M/2 whose pressure M/dt the
+//     next predicted stage feels: at a constrained equilibrium μ = dt·p − M/2, so M = dt·p is the
+//     fixed point, reached in one step once the motion is quasi-static.
 //   volume_apply: x += λ·w·g, v −= μ·w·g on the free surface elements; each of its work-groups
 //     sums the partials itself (the same sums in the same order as volume_finish), so a
 //     projection is two launches (partials, apply), not three.
@@ -157,6 +161,13 @@ void volume_finish(global const real* partial, uint groups, real rest_volume, gl
     for (int k = 0; k < 4; ++k) scalars[k] = out[k];
 }
 
+// The lagged multiplier after a correction that removed μ (one work-item; nothing without VB_VOLUME_LAG).
+inline void lag_update(global real* scalars, real mu) {
+#if VB_VOLUME_LAG
+  scalars[4] = mu + (real)0.5 * scalars[4];
+#endif
+}
+
 // x += λ·w·g, v −= μ·w·g on free surface element e.
 inline void volume_apply_one(uint e, global real4* u, global real4* v, real4 g, const real out[4]) {
   const real4 ui = u[e];
@@ -175,8 +186,10 @@ void volume_apply(global real4* u, global real4* v, global const uchar* mesh, ui
   const uint i = get_global_id(0), l = get_local_id(0);
   real out[4];
   volume_scalars(partial, groups, rest_volume, s, VB_CHECK_WG, l, out);
-  if (i == 0)
+  if (i == 0) {
+    lag_update(scalars, out[1]);
     for (int k = 0; k < 4; ++k) scalars[k] = out[k];
+  }
   if (i >= n_surface) return;
   const uint e = surface_elements[i];
   volume_apply_one(e, u, v, grad[e], out);
@@ -234,6 +247,7 @@ void volume_project(global real4* u, global real4* v, VB_LATTICE_KERNEL_PARAMS, 
       if (e[r] != 0xffffffffu) volume_apply_one(e[r], u, v, g[r], out);
   }
   if (l == 0) {
+    lag_update(scalars, out[1]);
     for (int k = 0; k < 4; ++k) scalars[k] = out[k];
     *groups_done = 0;  // ready for the next launch
   }

@@ -221,8 +221,12 @@ struct OutputSpec {
 /// free surface elements are projected so that the volume enclosed by the surface mesh returns to
 /// its rest value, and the velocity along the volume gradient is removed.
 struct VolumeSpec {
+  /// How Heun's predicted stage (ũ, ṽ) meets the constraint: the pressure of the last correction
+  /// as a force (no projection of its own), or a projection like the corrected stage's.
+  enum class Predictor { Pressure, Projection };
   bool preserve = false;  ///< off unless the scene asks
   int every = 1;          ///< steps between corrections (≥ 1)
+  Predictor predictor = Predictor::Pressure;
   int line = 0;
 };
 

@@ -39,7 +39,7 @@ constexpr int kCheckIndenter = kCheckLattice + kLatticeArgs; // then partial, pa
 constexpr int kTriangleArgs = 4;
 constexpr int kCheckVolume = kCheckIndenter + kIndenterArgs + 3;  // VB_VOLUME: grad, scalars
 // kernels/volume.cl: volume_partials takes u, v, the lattice parameters, then these.
-constexpr int kVolumeSlots = 5, kVolumeScalars = 4;
+constexpr int kVolumeSlots = 5, kVolumeScalars = 5;  // scalars: λ, μ, V, p, M (kernels/volume.cl)
 constexpr int kVolumeMesh = 2 + kLatticeArgs;  // mesh arena, its offsets, n_tri, n_surf
 constexpr int kVolumeCentre = kVolumeMesh + 4, kVolumeWithForce = kVolumeMesh + 6;
 // volume_project: u, v, the lattice parameters, the mesh, centre, then grad, partial, V0, scalars, count
@@ -283,6 +283,13 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   persistent_ = plan_persistent_step(cl.info, heun_steps && !tri_contact_ && !(volume_ && volume_launches_ == 0),
                                      el.hyperelastic, n_, force_split_, kSplitMaxElements);
   options += persistent_.options();
+  // Heun's predicted stage under the last correction's pressure instead of a projection of its
+  // own (docs/PHYSICS.md, "Volume preservation"): two launches fewer per step. Projected as before
+  // when the scene asks, between corrections (every > 1: no multiplier to lag), with folded
+  // projections, and in the one-launch step (kernels/persistent.cl keeps its own schedule).
+  volume_lag_ = volume_ && heun_steps && scene.volume.every == 1 &&
+                scene.volume.predictor == VolumeSpec::Predictor::Pressure && volume_launches_ != 0 && !persistent_.on;
+  options += " -DVB_VOLUME_LAG=" + std::to_string(volume_lag_);
   {
     const std::size_t per = kSplitWorkGroup / std::size_t(force_split_);
     step_global_ = force_split_ > 1 ? cl::NDRange((n_ + per - 1) / per * kSplitWorkGroup) : global_;
@@ -526,6 +533,11 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
     vol_pending_.setArg(kProjectRestVolume + 2, vol_done_);
     set_fold_args(false, false);
   }
+  if (volume_lag_) {  // heun_predict's (and heun_predict_lanes') last arguments before VB_TRI_PARAMS
+    const int last = int(predict_.getInfo<CL_KERNEL_NUM_ARGS>()) - (tri_contact_ ? kTriangleArgs : 0);
+    predict_.setArg(last - 2, vol_grad_);
+    predict_.setArg(last - 1, vol_scalars_);
+  }
   set_rest_volume_args();
   check_.setArg(kCheckVolume, vol_grad_);
   check_.setArg(kCheckVolume + 1, vol_scalars_);
@@ -608,16 +620,19 @@ double Simulator::enclosed_volume_m3() {
   return read_enclosed_volume_m3();
 }
 
-double Simulator::read_enclosed_volume_m3() const {
-  std::vector<double> scalars(kVolumeScalars);  // λ, μ, V, p (kernels/volume.cl)
+double Simulator::read_enclosed_volume_m3() const { return frame_sign_ * volume_scalars().volume_m3; }
+
+Simulator::VolumeScalars Simulator::volume_scalars() const {
+  require(volume_, "the volume constraint's scalars exist only with [volume] preserve = true");
+  std::vector<double> s(kVolumeScalars);  // λ, μ, V, p, M (kernels/volume.cl)
   if (precision_ == Precision::Double) {
-    cl_.queue.enqueueReadBuffer(vol_scalars_, CL_TRUE, 0, scalars.size() * sizeof(double), scalars.data());
+    cl_.queue.enqueueReadBuffer(vol_scalars_, CL_TRUE, 0, s.size() * sizeof(double), s.data());
   } else {
     std::vector<float> f(kVolumeScalars);
     cl_.queue.enqueueReadBuffer(vol_scalars_, CL_TRUE, 0, f.size() * sizeof(float), f.data());
-    std::copy(f.begin(), f.end(), scalars.begin());
+    std::copy(f.begin(), f.end(), s.begin());
   }
-  return frame_sign_ * scalars[2];
+  return {s[0], s[1], s[2], s[3], s[4]};
 }
 
 std::vector<double> Simulator::volume_gradient_m2() {
@@ -903,9 +918,10 @@ void Simulator::advance(std::int64_t steps) {
       enqueue_stress(u_);
       enqueue_triangle_contact(u_, t0);
       launch(predict_, step_global_, step_local_);
-      // The predicted stage is projected too: its velocity along g would otherwise reach the
-      // corrector's dashpots and leave a steady slip at the constrained equilibrium.
-      if (project) enqueue_volume_correction(u_tmp_, v_tmp_);
+      // The predicted stage meets the constraint too, by the lagged pressure (in heun_predict) or
+      // its own projection: its velocity along g would otherwise reach the corrector's dashpots
+      // and leave a steady slip at the constrained equilibrium.
+      if (project && !volume_lag_) enqueue_volume_correction(u_tmp_, v_tmp_);
       enqueue_stress(u_tmp_);
       enqueue_triangle_contact(u_tmp_, t1);
       launch(correct_, step_global_, step_local_);
@@ -1054,6 +1070,11 @@ void Simulator::download(std::vector<double>& u, std::vector<double>& v) const {
 void Simulator::upload(const std::vector<double>& u, const std::vector<double>& v) {
   require(u.size() == 3 * n_ && v.size() == 3 * n_, "state size does not match the model");
   pending_ = false;  // the new state replaces the one the projection was for
+  if (volume_lag_) {  // nor is the lagged multiplier that of the new state: start it at zero
+    const std::size_t m = std::size_t(kVolumeScalars - 1) * real_size_;
+    if (precision_ == Precision::Double) cl_.queue.enqueueFillBuffer(vol_scalars_, cl_double(0), m, real_size_);
+    else cl_.queue.enqueueFillBuffer(vol_scalars_, cl_float(0), m, real_size_);
+  }
   if (precision_ == Precision::Double) {
     write_xyz<double>(u_, u, &inverse_mass_);
     write_xyz<double>(v_, v, nullptr);

@@ -153,6 +153,16 @@ class Simulator {
   /// VOXBREAST_VOLUME_LAUNCHES=0): volume_pending computes the projection and the kernels that read
   /// the state next apply it, with no apply launch (kernels/volume.cl)
   int volume_launches() const { return volume_launches_; }
+  /// Whether Heun's predicted stage feels the lagged constraint pressure instead of being projected.
+  bool volume_predictor_pressure() const { return volume_lag_; }
+  /// The volume constraint's scalars as the last kernel left them (kernels/volume.cl; lattice
+  /// frame): the last correction's λ (m³ per unit w|g|²) and μ, the last sums' volume V (m³) and
+  /// pressure p (Pa, computed by check()), and the lagged multiplier M (Pa·s: M/dt is the pressure
+  /// the predicted stage feels; zero unless volume_predictor_pressure()).
+  struct VolumeScalars {
+    double lambda = 0, mu = 0, volume_m3 = 0, pressure_pa = 0, lagged = 0;
+  };
+  VolumeScalars volume_scalars() const;
   /// work-items per element in Heun's force passes (kernels/integrate.cl, VB_SPLIT): 2 on GPUs for
   /// hyperelastic models up to 262,144 elements, else 1; VOXBREAST_FORCE_SPLIT=1|2|4 overrides
   int force_split() const { return force_split_; }
@@ -278,6 +288,7 @@ class Simulator {
   std::size_t volume_triangles_ = 0, volume_surface_ = 0, volume_groups_ = 0;
   std::size_t volume_wg_ = 0;   ///< work-group size of volume_project (VB_VOLUME_WG)
   int volume_launches_ = 1;     ///< per projection: 1 volume_project, 2 volume_partials + volume_apply, 0 folded
+  bool volume_lag_ = false;  ///< Heun's predicted stage under the lagged pressure, not projected
   DeviceArena vol_mesh_;  ///< triangles, surface elements, incident start, incident (kernels/volume.cl)
   cl_uint4 vol_mesh_at_{};
   cl::Buffer vol_grad_, vol_partial_,

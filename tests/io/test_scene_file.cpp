@@ -254,6 +254,7 @@ TEST(SceneFile, AbsentSectionsKeepDefaults) {
   EXPECT_EQ(s.model.downsample, 1);
   EXPECT_FALSE(s.volume.preserve);
   EXPECT_EQ(s.volume.every, 1);
+  EXPECT_EQ(s.volume.predictor, VolumeSpec::Predictor::Pressure);
   EXPECT_TRUE(s.source_path.empty());
 }
 
@@ -263,6 +264,9 @@ TEST(SceneFile, VolumeSectionParses) {
   EXPECT_EQ(s.volume.every, 4);
   EXPECT_EQ(s.volume.line, 10);
   EXPECT_FALSE(parse_scene_text(kBase + "[volume]\npreserve = false\n", "scene.toml").volume.preserve);
+  EXPECT_EQ(s.volume.predictor, VolumeSpec::Predictor::Pressure);
+  EXPECT_EQ(parse_scene_text(kBase + "[volume]\npreserve = true\npredictor = \"projection\"\n", "scene.toml").volume.predictor,
+            VolumeSpec::Predictor::Projection);
 }
 
 TEST(SceneFile, ReferenceStateAndReproducibilitySectionsParse) {
@@ -462,6 +466,8 @@ std::vector<ErrorCase> error_cases() {
        {"integer ≥ 1"}},
       {"VolumeEveryFloat", kBase + "[volume]\nevery = 2.0\n", "volume.every", 11,
        {"expected an integer"}},
+      {"VolumeUnknownPredictor", kBase + "[volume]\npreserve = true\npredictor = \"projected\"\n",
+       "volume.predictor", 12, {"unknown value 'projected'", "accepted: pressure, projection"}},
       {"TomlSyntaxError", kBase + "[solver\n", "", 10, {"TOML syntax error", "scene.toml:10:"}},
       {"ReferenceStateNeedsPosture", kBase + "[gravity]\nposture = \"prone\"\n[reference_state]\ntolerance_mm = 0.01\n",
        "reference_state.ct_posture", 12, {"needs the CT's posture"}},
