@@ -284,9 +284,10 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
                                      el.hyperelastic, n_, force_split_, kSplitMaxElements);
   options += persistent_.options();
   // Heun's predicted stage under the last correction's pressure instead of a projection of its
-  // own (docs/PHYSICS.md, "Volume preservation"): two launches fewer per step. Projected as before
-  // when the scene asks, between corrections (every > 1: no multiplier to lag), with folded
-  // projections, and in the one-launch step (kernels/persistent.cl keeps its own schedule).
+  // own (docs/PHYSICS.md, "Volume preservation"): one launch fewer per step on CPUs, two on GPUs.
+  // Projected as before when the scene asks, between corrections (every > 1: no multiplier to
+  // lag), with folded projections, and in the one-launch step (kernels/persistent.cl keeps its
+  // own schedule).
   volume_lag_ = volume_ && heun_steps && scene.volume.every == 1 &&
                 scene.volume.predictor == VolumeSpec::Predictor::Pressure && volume_launches_ != 0 && !persistent_.on;
   options += " -DVB_VOLUME_LAG=" + std::to_string(volume_lag_);

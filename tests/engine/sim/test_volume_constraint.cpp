@@ -1,7 +1,8 @@
 // Volume preservation ([volume] preserve, kernels/volume.cl; docs/PHYSICS.md "Volume
 // preservation"): the device's enclosed volume and gradient against engine/surface's, a soft block
-// squashed by its weight with and without the constraint, no action on rigid motion, and the
-// bundled phantom lying prone.
+// squashed by its weight with and without the constraint (and with Heun's predicted stage under
+// the lagged pressure against its projection), no action on rigid motion, and the bundled phantom
+// lying prone.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
