@@ -172,9 +172,9 @@ struct DeviceAlone {
 /// (about `host_s_per_step` each) behind it, so the time to the end of the queue less the holding
 /// kernel's own time is the steps' device time, however slow the host's launches are. (A profiling
 /// queue cannot tell: on NVIDIA its events slow the device as well, and its completion callbacks
-/// come after the queue has drained, so the holder's end cannot be seen directly.) The holder's
-/// time is measured beside each of three runs and the median run taken, because on a loaded CPU
-/// device (PoCL beside other work) the holder's time varies from run to run. If the host had not
+/// came late, often after the queue had drained, so the holder's end cannot be seen directly.)
+/// The holder's time is measured beside each of three runs and the median run taken, because on a
+/// loaded CPU device (PoCL beside other work) the holder's time varies from run to run. If the host had not
 /// finished enqueueing when the holding kernel ended, the time includes waits for the host and is
 /// only an upper bound.
 DeviceAlone device_time_per_step(const ClContext& cl, Simulator& sim, std::int64_t steps, double host_s_per_step) {
@@ -294,6 +294,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
       scene = block_scene(c);
       lattice = build_lattice(voxelise_shapes(scene));
     }
+    scene.volume.predictor = o.volume_predictor;
     const ElementArrays el = make_element_arrays(scene, lattice);
     Simulator sim(scene, lattice, el, cl);
     const double sps = time_steps(sim, target_s);
@@ -312,6 +313,10 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                           {"fraction_of_copy_bandwidth", effective / bandwidth},
                           {"device_bytes_per_element", double(sim.device_bytes()) / double(n)},
                           {"volume_launches_per_projection", c.volume ? sim.volume_launches() : 0},
+                          // what ran: the one-launch step projects whatever the option says
+                          {"volume_predictor", !c.volume                         ? nlohmann::json()
+                                               : sim.volume_predictor_pressure() ? nlohmann::json("pressure")
+                                                                                 : nlohmann::json("projection")},
                           {"force_split", sim.force_split()}, {"persistent_step", sim.persistent_step()},
                           {"lanes_kernels", sim.lanes()}};
     csv << c.name << "," << n << "," << c.law << "," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","

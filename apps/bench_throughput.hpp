@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/scene/scene.hpp"
 #include "engine/sim/opencl_runtime.hpp"
 
 namespace vb::app {
@@ -14,6 +15,7 @@ struct ThroughputOptions {
   std::vector<std::string> laws{"linear"};  ///< laws timed with Heun + float
   bool quick = false;                       ///< 0.5 s per timing, Heun + float only
   bool volume = false;   ///< also time each law with [volume] preserve = true (model "block_volume")
+  VolumeSpec::Predictor volume_predictor = VolumeSpec::Predictor::Pressure;  ///< [volume] predictor of those
   bool profile = false;  ///< print device time per kernel (a second, profiling run of each block)
   /// the breast phantom's scene.toml: also time it resampled to ~36k elements (models "breast",
   /// "breast_volume"), every law; empty: blocks only

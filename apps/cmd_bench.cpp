@@ -35,6 +35,7 @@ struct BenchOptions {
   std::string out, device, phantom;
   bool quick = false, large = false, no_study = false, dry_run = false, haptic = false;
   bool volume = false, profile = false;  ///< throughput: block_volume cases; per-kernel device times
+  std::string volume_predictor = "pressure";  ///< throughput: [volume] predictor of the volume cases
   bool breast = false;  ///< throughput: the phantom at ~36k elements too
   std::vector<int> sizes;  ///< throughput blocks (edge lengths in elements)
   std::vector<int> haptic_elements = {10000};  ///< haptic-rate blocks (about this many elements)
@@ -146,6 +147,8 @@ int run_bench(BenchOptions o) {
     t.sizes = !o.sizes.empty() || o.breast ? o.sizes : std::vector<int>{33, 115};
     t.quick = o.quick;
     t.volume = o.volume;
+    t.volume_predictor =
+        o.volume_predictor == "projection" ? VolumeSpec::Predictor::Projection : VolumeSpec::Predictor::Pressure;
     t.profile = o.profile;
     if (o.breast) {
       require(!o.phantom.empty(), "--breast needs the phantom's scene", "bench --breast", "give --phantom");
@@ -225,6 +228,10 @@ Command add_bench(CLI::App& app) {
   sub->add_flag("--breast", o->breast,
                 "throughput: also time the breast phantom resampled to ~36k elements (models breast, breast_volume)");
   sub->add_flag("--volume", o->volume, "throughput: also time each law with [volume] preserve = true (model block_volume)");
+  sub->add_option("--volume-predictor", o->volume_predictor,
+                  "throughput: [volume] predictor of the --volume models: pressure (default) or projection, to time "
+                  "the two ways Heun's predicted stage meets the constraint")
+      ->check(CLI::IsMember({"pressure", "projection"}));
   sub->add_flag("--profile", o->profile, "throughput: print whether the host or the device sets the pace (host "
                                          "enqueue time, the device's time alone, the timed step) and the device time "
                                          "and launches per step of each kernel (a second run of each block on a "

@@ -10,6 +10,7 @@
 # Switches the A/B rows also try (docs/PERF_NOTES.md, changes 7–9):
 #   VOXBREAST_FORCE_SPLIT=1|2|4      work-items per element in Heun's force passes (GPU default 2
 #                                    for hyperelastic models up to 262,144 elements)
+#   --volume-predictor projection    the volume rows with Heun's predicted stage projected (change 15)
 #   VOXBREAST_PERSISTENT=0|1         Heun's step as one launch with grid barriers (NVIDIA default
 #                                    for spring models up to 262,144 elements; the 36k rows run
 #                                    the default and =0, the target row also =1)
@@ -49,6 +50,8 @@ for round in 1 2; do
   row "36k_r$round" voxbreast --sizes 33 --laws linear ogden --volume
   # one launch per pass instead of the persistent step (kernels/persistent.cl)
   VOXBREAST_PERSISTENT=0 row "36k_launches_r$round" voxbreast --sizes 33 --laws linear ogden --volume
+  # Heun's predicted stage projected instead of under the lagged pressure (PERF_NOTES.md change 15)
+  row "36k_projection_r$round" voxbreast --sizes 33 --laws ogden --volume --volume-predictor projection
   [[ -n "$ref" ]] && row "36k_ref_r$round" "$ref" --sizes 33 --laws linear ogden --volume
 done
 # the breast phantom at 3.2 mm (34,961 elements, a third of them moving) next to the cube

@@ -37,9 +37,10 @@ if "Portable Computing Language" in bench["platform"]:
 PY
 
 # --profile: which side sets the pace. The device's time alone (steps queued behind a held queue,
-# timed from the holder's completion callback) must be measured and be a real step time. It is not
-# compared with the timed step here: the two are taken at different moments on CPUs shared with the
-# suite's other tests, so their ratio is not reproducible (a 3x bound failed once in CI).
+# the holder's own time taken off, median of three runs) must be measured and be a real step
+# time. It is not compared with the timed step here: the two are taken at different moments on
+# CPUs shared with the suite's other tests, so their ratio is not reproducible (a 3x bound failed
+# once in CI).
 "$bin" bench --quick --no-study --sizes 8 --laws linear --volume --profile --out "$work/profile" >"$work/profile.log"
 /usr/bin/python3 - "$work/profile/bench.json" <<'PY'
 import json, math, sys
@@ -48,9 +49,23 @@ assert rows, "no throughput rows"
 for r in rows:
     device, host = r["device_alone_us_per_step"], r["host_enqueue_us_per_step"]
     timed = 1e6 / r["steps_per_s"]
-    # on PoCL the holder's completion callback comes long before its 64 steps drain
+    # measured: the median of three runs left the steps a positive time (null otherwise)
     assert device is not None, ("device alone not measured", r)
     assert math.isfinite(device) and device > 0 and math.isfinite(host) and host > 0, r
     assert isinstance(r["device_alone_host_ahead"], bool), r
+    # what ran: the default predictor on the volume model, none on the other
+    assert r["volume_predictor"] == ("pressure" if r["model"] == "block_volume" else None), r
     print(f'{r["model"]}: device alone {device:.1f} us/step, host enqueue {host:.1f}, timed {timed:.1f}')
+PY
+
+# --volume-predictor projection: the volume model runs Heun's predicted stage projected (the
+# row says what ran; PoCL has no one-launch step that would project it anyway).
+"$bin" bench --quick --no-study --sizes 8 --laws linear --volume --volume-predictor projection \
+  --out "$work/projection" >"$work/projection.log"
+/usr/bin/python3 - "$work/projection/bench.json" <<'PY'
+import json, sys
+rows = {r["model"]: r for r in json.load(open(sys.argv[1]))["throughput"]}
+assert rows["block_volume"]["volume_predictor"] == "projection", rows["block_volume"]
+assert rows["block"]["volume_predictor"] is None, rows["block"]
+print("--volume-predictor projection:", rows["block_volume"]["steps_per_s"], "steps/s")
 PY
