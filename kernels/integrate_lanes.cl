@@ -121,8 +121,7 @@ VB_INLINE lane3 lane_acceleration(lane3 f, real w, lane3 vi, real4 gravity, real
 VB_INLINE void lane_explicit_stage(global const real4* u4, global const real4* v4, global real4* u_out,
                                    global real4* v_out, VB_LATTICE_KERNEL_PARAMS, real dt, uint n_free, int one,
                                    global const uint* free_list, int symplectic, int relax,
-                                   global const real* relax_scale, real c, int lag, global const real* lag_g,
-                                   real lag_p) {
+                                   global const real* relax_scale, real c, VB_LAG_PARAMS) {
   VB_UNPACK_LATTICE;
   const uint k = get_global_id(0);
   if (k >= n_free) return;
@@ -134,7 +133,7 @@ VB_INLINE void lane_explicit_stage(global const real4* u4, global const real4* v
   lane3 a = lane_acceleration(
       lane_lattice_force(e, ui, wi, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio, one), wi, vi, gravity, damping);
   if (lag) {  // Heun's predicted stage under the lagged constraint pressure (integrate.cl, lag_force)
-    const lane3 g = lane_xyz(lag_g, e, one);
+    const lane3 g = lane_xyz((global const real*)lag_g, e, one);
     a.x -= lag_p * wi * g.x;
     a.y -= lag_p * wi * g.y;
     a.z -= lag_p * wi * g.z;
@@ -154,18 +153,14 @@ VB_INLINE void lane_explicit_stage(global const real4* u4, global const real4* v
 kernel void heun_predict_lanes(global const real4* u, global const real4* v, global real4* u_pred,
                                global real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
                                uint n_free, int one, global const uint* free_list VB_LAG_KERNEL_PARAMS) {
-#if VB_VOLUME_LAG
-  lane_explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 0, 0, 0, 0, 1,
-                      (global const real*)lag_g, lag_scalars[4] / dt);
-#else
-  lane_explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 0, 0, 0, 0, 0, 0, 0);
-#endif
+  lane_explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 0, 0, 0, 0,
+                      VB_LAG_KERNEL_ARGS);
 }
 
 kernel void euler_step_lanes(global const real4* u, global const real4* v, global real4* u_out, global real4* v_out,
                              VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt, uint n_free, int one,
                              global const uint* free_list) {
-  lane_explicit_stage(u, v, u_out, v_out, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 0, 0, 0, 0, 0, 0);
+  lane_explicit_stage(u, v, u_out, v_out, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 0, 0, 0, VB_NO_LAG);
 }
 
 // Heun's corrector: u' = u + dt/2·(v + ṽ), v' = (v + ṽ)/2 + dt/2·a(ũ, ṽ), forces from the predicted

@@ -39,7 +39,7 @@ kernel void relax_step_lanes(global const real4* u, global const real4* v, globa
                              global real4* v_out, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
                              uint n_free, global const real* relax_scale, real c, int one,
                              global const uint* free_list) {
-  lane_explicit_stage(u, v, u_out, v_out, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 1, relax_scale, c, 0, 0,
-                      0);
+  lane_explicit_stage(u, v, u_out, v_out, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 1, relax_scale, c,
+                      VB_NO_LAG);
 }
 #endif

@@ -625,14 +625,7 @@ double Simulator::read_enclosed_volume_m3() const { return frame_sign_ * volume_
 
 Simulator::VolumeScalars Simulator::volume_scalars() const {
   require(volume_, "the volume constraint's scalars exist only with [volume] preserve = true");
-  std::vector<double> s(kVolumeScalars);  // λ, μ, V, p, M (kernels/volume.cl)
-  if (precision_ == Precision::Double) {
-    cl_.queue.enqueueReadBuffer(vol_scalars_, CL_TRUE, 0, s.size() * sizeof(double), s.data());
-  } else {
-    std::vector<float> f(kVolumeScalars);
-    cl_.queue.enqueueReadBuffer(vol_scalars_, CL_TRUE, 0, f.size() * sizeof(float), f.data());
-    std::copy(f.begin(), f.end(), s.begin());
-  }
+  const std::vector<double> s = read_reals(vol_scalars_, kVolumeScalars);  // λ, μ, V, p, M (kernels/volume.cl)
   return {s[0], s[1], s[2], s[3], s[4]};
 }
 
@@ -951,14 +944,7 @@ StateCheck Simulator::check() {
   if (volume_) enqueue_volume_sums(true);  // the pressure the residual leaves out
   enqueue_triangle_contact(u_, time_s());
   enqueue_check();
-  std::vector<double> p(check_groups_ * check_slots_);
-  if (precision_ == Precision::Double) {
-    cl_.queue.enqueueReadBuffer(partial_, CL_TRUE, 0, p.size() * sizeof(double), p.data());
-  } else {
-    std::vector<float> pf(p.size());
-    cl_.queue.enqueueReadBuffer(partial_, CL_TRUE, 0, pf.size() * sizeof(float), pf.data());
-    std::copy(pf.begin(), pf.end(), p.begin());
-  }
+  const std::vector<double> p = read_reals(partial_, check_groups_ * check_slots_);
   std::vector<cl_int> arg(check_groups_);
   cl_.queue.enqueueReadBuffer(partial_arg_, CL_TRUE, 0, arg.size() * sizeof(cl_int), arg.data());
 
@@ -1029,6 +1015,18 @@ void Simulator::set_gravity(const Vec3& g) {
   }
 }
 
+std::vector<double> Simulator::read_reals(const cl::Buffer& buffer, std::size_t count) const {
+  std::vector<double> out(count);
+  if (precision_ == Precision::Double) {
+    cl_.queue.enqueueReadBuffer(buffer, CL_TRUE, 0, count * sizeof(double), out.data());
+  } else {
+    std::vector<float> f(count);
+    cl_.queue.enqueueReadBuffer(buffer, CL_TRUE, 0, count * sizeof(float), f.data());
+    std::copy(f.begin(), f.end(), out.begin());
+  }
+  return out;
+}
+
 template <typename T>
 void Simulator::read_xyz(const cl::Buffer& buffer, std::vector<double>& world) const {
   std::vector<T> data(4 * n_);
@@ -1071,11 +1069,8 @@ void Simulator::download(std::vector<double>& u, std::vector<double>& v) const {
 void Simulator::upload(const std::vector<double>& u, const std::vector<double>& v) {
   require(u.size() == 3 * n_ && v.size() == 3 * n_, "state size does not match the model");
   pending_ = false;  // the new state replaces the one the projection was for
-  if (volume_lag_) {  // nor is the lagged multiplier that of the new state: start it at zero
-    const std::size_t m = std::size_t(kVolumeScalars - 1) * real_size_;
-    if (precision_ == Precision::Double) cl_.queue.enqueueFillBuffer(vol_scalars_, cl_double(0), m, real_size_);
-    else cl_.queue.enqueueFillBuffer(vol_scalars_, cl_float(0), m, real_size_);
-  }
+  if (volume_lag_)  // nor is the lagged multiplier that of the new state: start it at zero (all-zero bytes)
+    cl_.queue.enqueueFillBuffer(vol_scalars_, cl_uchar(0), std::size_t(kVolumeScalars - 1) * real_size_, real_size_);
   if (precision_ == Precision::Double) {
     write_xyz<double>(u_, u, &inverse_mass_);
     write_xyz<double>(v_, v, nullptr);
@@ -1159,14 +1154,7 @@ std::vector<double> Simulator::triangle_contact_forces_n() {
   require(tri_contact_, "no indenter of the scene uses contact_surface = \"triangles\"", "indenter");
   enqueue_triangle_contact(u_, time_s());
   const std::size_t count = 4 * 3 * tri_triangles_ * std::max<std::size_t>(1, scene_.indenters.size());
-  std::vector<double> raw(count);
-  if (precision_ == Precision::Double) {
-    cl_.queue.enqueueReadBuffer(corner_force_, CL_TRUE, 0, count * sizeof(double), raw.data());
-  } else {
-    std::vector<float> f(count);
-    cl_.queue.enqueueReadBuffer(corner_force_, CL_TRUE, 0, count * sizeof(float), f.data());
-    std::copy(f.begin(), f.end(), raw.begin());
-  }
+  const std::vector<double> raw = read_reals(corner_force_, count);
   std::vector<double> out(3 * (count / 4));
   for (std::size_t k = 0; k < count / 4; ++k) {
     const Vec3 w = lattice_.rotation * Vec3(raw[4 * k], raw[4 * k + 1], raw[4 * k + 2]);

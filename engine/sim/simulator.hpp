@@ -184,6 +184,8 @@ class Simulator {
   void set_real(cl::Kernel& k, int index, double x) const;
   /// sets a world vector, rotated into the lattice frame the kernels work in
   void set_world_vector(cl::Kernel& k, int index, const Vec3& world) const;
+  /// the first `count` reals of a buffer (float or double as the run's precision), blocking
+  std::vector<double> read_reals(const cl::Buffer& buffer, std::size_t count) const;
   template <typename T>
   void read_xyz(const cl::Buffer& buffer, std::vector<double>& world) const;
   template <typename T>
