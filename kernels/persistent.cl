@@ -142,7 +142,7 @@ void heun_step_persistent(global real4* u, global real4* v, global real4* u_pred
 #endif
   VB_FOR_BLOCKS(b, blocks) {
     predict_element(VB_BLOCK_ELEMENT(b), u, v, u_pred, v_pred, VB_LATTICE_ARGS, indenters, t0, t1, dt, n,
-                    VB_NO_PENDING, share);
+                    VB_NO_PENDING, VB_NO_LAG, share);
     VB_BLOCK_DONE;
   }
   grid_barrier(sync, VB_NEXT_BARRIER, &stamps);

@@ -316,6 +316,8 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   if (relax_) sources.push_back("relax.cl");
   sources.push_back("checks.cl");
   program_ = build_program(cl, sources, lattice_tables_source(), options);
+  kernel_files_ = sources;
+  build_options_ = options;
   if (hyper_) {
     stress_ = cl::Kernel(program_, "element_stress");
     set_element_fit_args(stress_);

@@ -171,6 +171,10 @@ class Simulator {
   bool lanes() const { return lanes_; }
   /// Heun's whole step runs as one launch (kernels/persistent.cl; NVIDIA GPUs, small models)
   bool persistent_step() const { return persistent_.on; }
+  /// The kernel files and build options of this model's program (build_program), so that a test
+  /// can build the variants a device here does not run (the one-launch step on PoCL).
+  const std::vector<std::string>& kernel_files() const { return kernel_files_; }
+  const std::string& build_options() const { return build_options_; }
 
  private:
   void set_indenter_args(cl::Kernel& k, int first_arg, double t_force, double t_project);
@@ -239,6 +243,8 @@ class Simulator {
   int check_slots_ = 0;  ///< hyperelastic: tissue ids, law table, Q and F rows
   cl::Kernel stress_;
   cl::Program program_;
+  std::vector<std::string> kernel_files_;
+  std::string build_options_;
   cl::Kernel euler_, predict_, correct_, relax_kernel_;
   bool relax_ = false;
   double damping_ = 0;  ///< global damping (1/s); adapted at each check when relaxing

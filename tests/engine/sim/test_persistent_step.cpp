@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/sim/kernel_tables.hpp"
+#include "engine/sim/opencl_runtime.hpp"
 #include "engine/sim/persistent_step.hpp"
 #include "engine/sim/simulator.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
@@ -98,6 +100,30 @@ TEST(PersistentStep, MatchesWithEveryForceSplitAndFewGroups) {
     if (one.empty()) GTEST_SKIP() << "no persistent step on this device (NVIDIA GPUs only)";
     EXPECT_LE(test::relative_difference(one, run_case(Case::OgdenVolumeEveryThird, false, split)), 1e-12) << split;
   }
+}
+
+// The one-launch step's kernel runs on NVIDIA GPUs only, so a change to a helper it shares with the
+// separate kernels (a parameter added to predict_element) could leave it unbuildable without any
+// CPU test noticing: it did once (session 14's lagged pressure), and every spring model stepping
+// with Heun on a GPU failed to build. Here each case's program is built again as the GPU would
+// build it, with the one-launch step compiled in (not launched: PoCL's groups are not co-resident),
+// with one and two work-items per element. Runs everywhere.
+TEST(PersistentStep, KernelBuildsOnEveryDevice) {
+  for (const Case c : {Case::SpringsVolume, Case::OgdenVolumeEveryThird, Case::OgdenPlates})
+    for (const char* split : {"1", "2"}) {
+      const Scene s = make_case(c);
+      const test::Model m = test::make_model(s);
+      setenv("VOXBREAST_FORCE_SPLIT", split, 1);
+      const Simulator sim(s, m.lattice, m.elements, test::cl_context());
+      unsetenv("VOXBREAST_FORCE_SPLIT");
+      std::string options = sim.build_options();
+      const std::string off = "-DVB_PERSISTENT=0";
+      const std::size_t at = options.find(off);
+      if (at != std::string::npos) options.replace(at, off.size(), "-DVB_PERSISTENT=1 -DVB_PERSISTENT_TRACE=0");
+      ASSERT_NE(options.find("-DVB_PERSISTENT=1"), std::string::npos) << options;
+      EXPECT_NO_THROW(build_program(test::cl_context(), sim.kernel_files(), lattice_tables_source(), options))
+          << "case " << int(c) << ", split " << split;
+    }
 }
 
 // The groups launched must all be resident: NVIDIA's compiler can use more registers than the
