@@ -268,15 +268,27 @@ inline mat3 stress_ogden(mat3 C, real J, global const real* mat) {
   return S;
 }
 
+// Heun's predicted stage read from (u, v) (VB_STRESS_PAIR): heun_predict moves every free element
+// to ũ = u + dt·v, whatever its force (kernels/integrate.cl, explicit_update, the same arithmetic),
+// so its stress needs no predicted state in memory. `predicted` is a constant at every call.
+#define VB_PREDICTED_PARAMS global const real4 *pred_v, real pred_dt, int predicted
+#define VB_PREDICTED_ARGS pred_v, pred_dt, predicted
+#define VB_NOT_PREDICTED (global const real4*)0, (real)0, 0
+inline void predicted_u(real4* uj, uint j, VB_PREDICTED_PARAMS) {
+  if (predicted && uj->w != 0) *uj += pred_dt * xyz0(pred_v[j]);
+}
+
 // Least-squares deformation gradient of element e from the displacements u of its existing
 // neighbours: F = A·B⁻¹ (see the top of this file). Sets B⁻¹ (in units of 1/h²) and the bit mask
 // of present neighbours; returns false when they do not span 3-D (a thin strand: no F). u is read
-// as a pending volume projection leaves it (kernels/common.cl).
+// as a pending volume projection leaves it (kernels/common.cl), or as Heun's predicted stage.
 inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_of, global const int* grid,
-                         int sy, int sz, real h, mat3* F, mat3* Bi, uint* present_out, VB_PENDING_PARAMS) {
+                         int sy, int sz, real h, mat3* F, mat3* Bi, uint* present_out, VB_PENDING_PARAMS,
+                         VB_PREDICTED_PARAMS) {
   const int cell = (int)cell_of[e];
   real4 ue = u[e], wg = (real4)(0);
   pending_u(&ue, &wg, e, VB_PENDING_ARGS);
+  predicted_u(&ue, e, VB_PREDICTED_ARGS);
   mat3 A = mat3_zero(), B = mat3_zero();  // B in units of h²
   uint present = 0;
 #pragma unroll
@@ -286,6 +298,7 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
     present |= 1u << d;
     real4 uj = u[j];
     pending_u(&uj, &wg, (uint)j, VB_PENDING_ARGS);
+    predicted_u(&uj, (uint)j, VB_PREDICTED_ARGS);
     const real dX[3] = {VB_DIR[d][0], VB_DIR[d][1], VB_DIR[d][2]};
     const real dx[3] = {h * dX[0] + (uj.x - ue.x), h * dX[1] + (uj.y - ue.y), h * dX[2] + (uj.z - ue.z)};
     // only d's nonzero components (constants once unrolled): adding x·0 changes nothing, but the
@@ -323,11 +336,12 @@ inline bool fit_gradient(global const real4* u, uint e, global const uint* cell_
 // F₀ (rest_frame: rows of R₀ = F₀⁻¹, J₀ = det F₀ in row 0's w): the law sees F·R₀ and the energy
 // J₀·V·W(F·R₀) gives Q = J₀·V·P(F·R₀)·R₀ᵀ·B⁻¹ on the same lattice offsets. C_out is that of the
 // deformation from rest (F·R₀), which the hourglass control applies to the rest connections.
-// u may have a volume projection pending (VB_PENDING_PARAMS: VB_VOLUME_FOLD's element_stress).
+// u may have a volume projection pending (VB_PENDING_PARAMS: VB_VOLUME_FOLD's element_stress), or
+// be read as Heun's predicted stage (VB_PREDICTED_PARAMS: VB_STRESS_PAIR's).
 // element_stress_one is element e's share, for element_stress below and for the persistent Heun
 // step (kernels/persistent.cl).
 inline void element_stress_one(uint e, global const real4* u, global uchar* arena, uint8 at, int sy, int sz, real h,
-                               global const real4* rest_frame, VB_PENDING_PARAMS) {
+                               global const real4* rest_frame, VB_PENDING_PARAMS, VB_PREDICTED_PARAMS) {
   VB_UNPACK_FIT;
   global real4* Q_out = (global real4*)VB_ARENA_AT(arena, at.s5);  // written here (hyper_store)
   global real4* C_out = (global real4*)VB_ARENA_AT(arena, at.s6);
@@ -336,7 +350,8 @@ inline void element_stress_one(uint e, global const real4* u, global uchar* aren
   mat3 F, Bi;
   uint present = 0;
   // spring tissue, or neighbours that do not span 3-D: no element stress
-  if (!VB_LAW_HYPER(law) || !fit_gradient(u, e, cell_of, grid, sy, sz, h, &F, &Bi, &present, VB_PENDING_ARGS)) {
+  if (!VB_LAW_HYPER(law) || !fit_gradient(u, e, cell_of, grid, sy, sz, h, &F, &Bi, &present, VB_PENDING_ARGS,
+                                                VB_PREDICTED_ARGS)) {
     hyper_store(Q_out, C_out, e, mat3_zero(), mat3_identity(), VB_LAW_HYPER(law));
     return;
   }
@@ -370,18 +385,32 @@ inline void element_stress_one(uint e, global const real4* u, global uchar* aren
 
 // With VB_VOLUME_FOLD, u may have a volume projection pending: its gradient pend_g and scalars
 // {λ, μ, …} (all zero when none is).
+// With VB_STRESS_PAIR (Heun), a launch over two rows of work-items computes both stages' stresses:
+// row 0 that of u into Q, C (slots 5, 6), row 1 that of the predicted stage u + dt·v into the
+// arena's slots pred_at (what heun_correct reads). One row is the stress of u alone (checks).
 kernel void element_stress(global const real4* u, global uchar* arena, uint8 at, int sy, int sz, real h, uint n,
                            global const real4* rest_frame
 #if VB_VOLUME_FOLD
                            , global const real4* pend_g, global const real* pend_scalars
 #endif
+#if VB_STRESS_PAIR
+                           , global const real4* v, real dt, uint2 pred_at
+#endif
 ) {
   const uint e = get_global_id(0);
   if (e >= n) return;
+#if VB_STRESS_PAIR
+  if (get_global_id(1) == 1) {
+    at.s5 = pred_at.x;
+    at.s6 = pred_at.y;
+    element_stress_one(e, u, arena, at, sy, sz, h, rest_frame, VB_NO_PENDING, v, dt, 1);
+    return;
+  }
+#endif
 #if VB_VOLUME_FOLD
-  element_stress_one(e, u, arena, at, sy, sz, h, rest_frame, pend_g, pend_scalars[0], (real)0, 1);
+  element_stress_one(e, u, arena, at, sy, sz, h, rest_frame, pend_g, pend_scalars[0], (real)0, 1, VB_NOT_PREDICTED);
 #else
-  element_stress_one(e, u, arena, at, sy, sz, h, rest_frame, VB_NO_PENDING);
+  element_stress_one(e, u, arena, at, sy, sz, h, rest_frame, VB_NO_PENDING, VB_NOT_PREDICTED);
 #endif
 }
 
@@ -399,7 +428,7 @@ kernel void rest_frame(global const real4* u0, global const uchar* arena, uint8 
   uint present = 0;
   real J0 = 1;
   mat3 R0 = mat3_identity();
-  if (VB_LAW_HYPER(law) && fit_gradient(u0, e, cell_of, grid, sy, sz, h, &F0, &Bi, &present, VB_NO_PENDING)) {
+  if (VB_LAW_HYPER(law) && fit_gradient(u0, e, cell_of, grid, sy, sz, h, &F0, &Bi, &present, VB_NO_PENDING, VB_NOT_PREDICTED)) {
     J0 = mat3_det(F0);
     R0 = mat3_inverse(F0, J0);
   }

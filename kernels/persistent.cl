@@ -78,7 +78,7 @@ inline void grid_barrier(volatile global uint* sync, uint target, uint* stamps) 
 inline void stress_pass(global const real4* u, global uchar* arena, uint8 at, int sy, int sz, real h, uint n,
                         global const real4* rest_frame) {
   for (uint e = get_global_id(0); e < n; e += get_global_size(0))
-    element_stress_one(e, u, arena, at, sy, sz, h, rest_frame, VB_NO_PENDING);
+    element_stress_one(e, u, arena, at, sy, sz, h, rest_frame, VB_NO_PENDING, VB_NOT_PREDICTED);
 }
 #endif
 

@@ -151,6 +151,10 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
                      3 * tri_triangles_ * scene.indenters.size() * 4 * real_size_;
   }
   contact_stiffness_n_m_ = penalty.stiffness_n_m;
+  rest_offsets_ = scene.reference_state.active;
+  hyper_ = el.hyperelastic;
+  plan_launches(scene, el, cl);
+  if (stress_pair_) device_bytes_ += n_ * 4 * 4 * real_size_;  // the predicted stage's Q rows and C
   require(double(device_bytes_) < 0.9 * double(cl.info.global_memory_bytes) &&
               std::max((el.hyperelastic ? 3 : 1) * state_bytes, cells * sizeof(cl_int)) <= cl.info.max_allocation_bytes,
           "the model needs " + mib(double(device_bytes_)) + " of device memory but '" + cl.info.name +
@@ -169,8 +173,6 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
 
   // The unloaded reference state: rest offsets (zero until set_rest_offsets), and for
   // hyperelastic tissue the rest frame R₀, J₀ (kernels/hyperelastic.cl); placeholders otherwise.
-  rest_offsets_ = scene.reference_state.active;
-  hyper_ = el.hyperelastic;
   const std::size_t offset_bytes = (rest_offsets_ ? n_ : 1) * 4 * real_size_;
   const std::size_t frame_bytes = (rest_offsets_ && hyper_ ? 3 * n_ : 1) * 4 * real_size_;
   if (rest_offsets_) device_bytes_ += offset_bytes + (hyper_ ? frame_bytes : 0);
@@ -234,19 +236,6 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_CHECK_WG=" + std::to_string(kCheckWorkGroup);
   options += " -DVB_VOLUME=" + std::to_string(volume_);
   if (volume_) {
-    // A projection is two launches on GPUs (volume_partials, volume_apply) and one elsewhere
-    // (volume_project). On an H200 the one-launch form's last work-group, applying the projection
-    // alone, took 21.8 µs against 7.9 + 10.8 µs for the two launches (docs/PERF_NOTES.md); on PoCL
-    // the two cost the same. VOXBREAST_VOLUME_LAUNCHES=1|2 overrides, to compare them on a device.
-    // 0 (Heun only): no apply launch at all, the kernels that read the state next apply the
-    // pending projection (volume_pending; kernels/common.cl, VB_PENDING_PARAMS).
-    volume_launches_ = cl.info.is_gpu ? 2 : 1;
-    if (const char* env = std::getenv("VOXBREAST_VOLUME_LAUNCHES")) {
-      const int k = std::atoi(env);
-      if (k == 1 || k == 2) volume_launches_ = k;
-      // Triangle contact reads the state without a pending projection: it keeps the apply launches.
-      if (k == 0 && scene.solver.integrator == Integrator::Heun && !tri_contact_) volume_launches_ = 0;
-    }
     const bool wide = cl.info.is_gpu &&
                       cl.info.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>() >= kVolumeGpuWorkGroup &&
                       kVolumeSlots * kVolumeGpuWorkGroup * real_size_ + 64 <= local_bytes;
@@ -259,38 +248,12 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     options += " -DVB_VOLUME_PAIRS=" + std::to_string(volume_pairs_);
   }
   options += " -DVB_VOLUME_FOLD=" + std::to_string(volume_ && volume_launches_ == 0);
-  // Heun's force passes on GPUs with each element's connections over 2 work-items for small
-  // hyperelastic models (kernels/integrate.cl, VB_SPLIT): ~1,100 warps at 36k elements leave a
-  // latency-bound pass short of threads. VOXBREAST_FORCE_SPLIT=1|2|4 overrides, on any device.
-  const bool heun_steps = scene.solver.integrator == Integrator::Heun;
-  force_split_ = heun_steps && cl.info.is_gpu && el.hyperelastic && n_ <= kSplitMaxElements ? 2 : 1;
-  if (const char* env = std::getenv("VOXBREAST_FORCE_SPLIT")) {
-    const int k = std::atoi(env);
-    if (heun_steps && (k == 1 || k == 2 || k == 4)) force_split_ = k;
-  }
   options += " -DVB_SPLIT=" + std::to_string(force_split_);
-  // Every integrator on CPUs for plain float spring models: the kernels on scalar components that
-  // PoCL widens across work-items (kernels/integrate_lanes.cl, relax.cl); VOXBREAST_LANES=0 keeps
-  // the real4 kernels, to compare.
-  lanes_ = !cl.info.is_gpu && precision_ == Precision::Float && !el.hyperelastic && !el.biphasic &&
-           scene.indenters.empty() && scene.tori.empty() && !tri_contact_ && !(volume_ && volume_launches_ == 0) &&
-           !rest_offsets_ && force_split_ == 1;
-  if (const char* env = std::getenv("VOXBREAST_LANES")) lanes_ = lanes_ && std::atoi(env) != 0;
   options += " -DVB_LANES=" + std::to_string(lanes_);
   options += " -DVB_NV_PTX=" + std::to_string(nvidia_ptx(cl.info));
-  // Heun's whole step in one launch where the device allows it (kernels/persistent.cl): not with
-  // triangle contact (its own pass) or folded projections (another way to fewer launches).
-  persistent_ = plan_persistent_step(cl.info, heun_steps && !tri_contact_ && !(volume_ && volume_launches_ == 0),
-                                     el.hyperelastic, n_, force_split_, kSplitMaxElements);
   options += persistent_.options();
-  // Heun's predicted stage under the last correction's pressure instead of a projection of its
-  // own (docs/PHYSICS.md, "Volume preservation"): one launch fewer per step on CPUs, two on GPUs.
-  // Projected as before when the scene asks, between corrections (every > 1: no multiplier to
-  // lag), with folded projections, and in the one-launch step (kernels/persistent.cl keeps its
-  // own schedule).
-  volume_lag_ = volume_ && heun_steps && scene.volume.every == 1 &&
-                scene.volume.predictor == VolumeSpec::Predictor::Pressure && volume_launches_ != 0 && !persistent_.on;
   options += " -DVB_VOLUME_LAG=" + std::to_string(volume_lag_);
+  options += " -DVB_STRESS_PAIR=" + std::to_string(stress_pair_);
   {
     const std::size_t per = kSplitWorkGroup / std::size_t(force_split_);
     step_global_ = force_split_ > 1 ? cl::NDRange((n_ + per - 1) / per * kSplitWorkGroup) : global_;
@@ -323,6 +286,11 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     set_element_fit_args(stress_);
     stress_.setArg(6, cl_uint(n_));
     stress_.setArg(7, rest_frame_);
+    if (stress_pair_) {  // kernels/hyperelastic.cl: v, dt and where the predicted stage's Q and C go
+      stress_.setArg(8, v_);
+      set_real(stress_, 9, dt_.dt_s);
+      stress_.setArg(10, cl_uint2{{arena_at_pred_.s[5], arena_at_pred_.s[6]}});
+    }
   }
 
   const bool heun = scene.solver.integrator == Integrator::Heun;
@@ -348,6 +316,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   if (heun) {
     predict_.setArg(0, u_); predict_.setArg(1, v_); predict_.setArg(2, u_tmp_); predict_.setArg(3, v_tmp_);
     correct_.setArg(0, u_); correct_.setArg(1, v_); correct_.setArg(2, u_tmp_); correct_.setArg(3, v_tmp_);
+    correct_.setArg(kStepLattice + 1, arena_at_pred_);  // the predicted stage's stress (arena_at_ without the pair)
   }
   set_lattice_args(check_, kCheckLattice);
   set_indenter_args(check_, kCheckIndenter, 0.0, 0.0);
@@ -372,6 +341,60 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   if (tri_contact_) make_triangle_contact_buffers();
   if (persistent_.on) make_persistent_kernel();
   if (rest_offsets_) set_rest_offsets(std::vector<double>(3 * n_, 0.0));  // R₀ = I, J₀ = 1
+}
+
+void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const ClContext& cl) {
+  const bool heun_steps = scene.solver.integrator == Integrator::Heun;
+  if (volume_) {
+    // A projection is two launches on GPUs (volume_partials, volume_apply) and one elsewhere
+    // (volume_project). On an H200 the one-launch form's last work-group, applying the projection
+    // alone, took 21.8 µs against 7.9 + 10.8 µs for the two launches (docs/PERF_NOTES.md); on PoCL
+    // the two cost the same. VOXBREAST_VOLUME_LAUNCHES=1|2 overrides, to compare them on a device.
+    // 0 (Heun only): no apply launch at all, the kernels that read the state next apply the
+    // pending projection (volume_pending; kernels/common.cl, VB_PENDING_PARAMS).
+    volume_launches_ = cl.info.is_gpu ? 2 : 1;
+    if (const char* env = std::getenv("VOXBREAST_VOLUME_LAUNCHES")) {
+      const int k = std::atoi(env);
+      if (k == 1 || k == 2) volume_launches_ = k;
+      // Triangle contact reads the state without a pending projection: it keeps the apply launches.
+      if (k == 0 && heun_steps && !tri_contact_) volume_launches_ = 0;
+    }
+  }
+  const bool folded = volume_ && volume_launches_ == 0;
+  // Heun's force passes on GPUs with each element's connections over 2 work-items for small
+  // hyperelastic models (kernels/integrate.cl, VB_SPLIT): ~1,100 warps at 36k elements leave a
+  // latency-bound pass short of threads. VOXBREAST_FORCE_SPLIT=1|2|4 overrides, on any device.
+  force_split_ = heun_steps && cl.info.is_gpu && el.hyperelastic && n_ <= kSplitMaxElements ? 2 : 1;
+  if (const char* env = std::getenv("VOXBREAST_FORCE_SPLIT")) {
+    const int k = std::atoi(env);
+    if (heun_steps && (k == 1 || k == 2 || k == 4)) force_split_ = k;
+  }
+  // Every integrator on CPUs for plain float spring models: the kernels on scalar components that
+  // PoCL widens across work-items (kernels/integrate_lanes.cl, relax.cl); VOXBREAST_LANES=0 keeps
+  // the real4 kernels, to compare.
+  lanes_ = !cl.info.is_gpu && precision_ == Precision::Float && !el.hyperelastic && !el.biphasic &&
+           scene.indenters.empty() && scene.tori.empty() && !tri_contact_ && !folded && !rest_offsets_ &&
+           force_split_ == 1;
+  if (const char* env = std::getenv("VOXBREAST_LANES")) lanes_ = lanes_ && std::atoi(env) != 0;
+  // Heun's whole step in one launch where the device allows it (kernels/persistent.cl): not with
+  // triangle contact (its own pass) or folded projections (another way to fewer launches).
+  persistent_ = plan_persistent_step(cl.info, heun_steps && !tri_contact_ && !folded, el.hyperelastic, n_,
+                                     force_split_, kSplitMaxElements);
+  // Heun's predicted stage under the last correction's pressure instead of a projection of its
+  // own (docs/PHYSICS.md, "Volume preservation"): one launch fewer per step on CPUs, two on GPUs.
+  // Projected as before when the scene asks, between corrections (every > 1: no multiplier to
+  // lag), with folded projections, and in the one-launch step (kernels/persistent.cl keeps its
+  // own schedule).
+  volume_lag_ = volume_ && heun_steps && scene.volume.every == 1 &&
+                scene.volume.predictor == VolumeSpec::Predictor::Pressure && !folded && !persistent_.on;
+  // Both of Heun's element stresses in one launch (kernels/hyperelastic.cl, VB_STRESS_PAIR): the
+  // predicted stage moves each free element to ũ = u + dt·v whatever its force, so the stress at ũ
+  // needs only (u, v). Not where something else moves ũ: indenters and tori project it out of
+  // themselves, the predicted stage's own volume projection; nor with folded projections or the
+  // one-launch step (their own passes). VOXBREAST_STRESS_PAIR=0 keeps two launches, to compare.
+  stress_pair_ = hyper_ && heun_steps && scene.indenters.empty() && scene.tori.empty() && (!volume_ || volume_lag_) &&
+                 !folded && !persistent_.on;
+  if (const char* env = std::getenv("VOXBREAST_STRESS_PAIR")) stress_pair_ = stress_pair_ && std::atoi(env) != 0;
 }
 
 void Simulator::make_lane_args() {
@@ -665,12 +688,20 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
       arena_.add(nullptr, 3 * row_bytes),
       arena_.add(nullptr, row_bytes),
       arena_.add(nullptr, offset_bytes)};  // rest offsets: zero until set_rest_offsets
+  // The predicted stage's Q and C (stress_pair_): what heun_correct reads in place of slots 5 and 6.
+  const std::size_t pred_q = stress_pair_ ? arena_.add(nullptr, 3 * row_bytes) : 0;
+  const std::size_t pred_c = stress_pair_ ? arena_.add(nullptr, row_bytes) : 0;
   require(arena_.bytes() <= cl_.info.max_allocation_bytes,
           "the model's arrays need one buffer of " + mib(double(arena_.bytes())) + " but '" + cl_.info.name +
               "' allocates at most " + mib(double(cl_.info.max_allocation_bytes)),
           "model", "downsample or crop the model");
   arena_.create(cl_);
   for (int i = 0; i < 8; ++i) arena_at_.s[i] = arena_.offset_units(slot[i]);
+  arena_at_pred_ = arena_at_;
+  if (stress_pair_) {
+    arena_at_pred_.s[5] = arena_.offset_units(pred_q);
+    arena_at_pred_.s[6] = arena_.offset_units(pred_c);
+  }
   E_ = arena_.part(slot[0]);
   cell_ = arena_.part(slot[1]);
   rest_offset_ = arena_.part(slot[7]);
@@ -873,6 +904,13 @@ void Simulator::enqueue_stress(const cl::Buffer& u, const cl::Buffer* pending_gr
   enqueue(stress_);
 }
 
+void Simulator::enqueue_stress_pair() {
+  // Heun's two stages as two rows of work-items (kernels/hyperelastic.cl, element_stress)
+  stress_.setArg(0, u_);
+  const cl::NDRange local = local_.dimensions() ? cl::NDRange(local_[0], 1) : cl::NullRange;
+  launch(stress_, cl::NDRange(global_[0], 2), local);
+}
+
 void Simulator::enqueue_check() const {
   // check_state declares reqd_work_group_size, so its local size is always given
   launch(check_, global_, cl::NDRange(kCheckWorkGroup));
@@ -911,14 +949,14 @@ void Simulator::advance(std::int64_t steps) {
         pending_ = project;
         continue;
       }
-      enqueue_stress(u_);
+      if (stress_pair_) enqueue_stress_pair(); else enqueue_stress(u_);
       enqueue_triangle_contact(u_, t0);
       launch(predict_, step_global_, step_local_);
       // The predicted stage meets the constraint too, by the lagged pressure (in heun_predict) or
       // its own projection: its velocity along g would otherwise reach the corrector's dashpots
       // and leave a steady slip at the constrained equilibrium.
       if (project && !volume_lag_) enqueue_volume_correction(u_tmp_, v_tmp_);
-      enqueue_stress(u_tmp_);
+      if (!stress_pair_) enqueue_stress(u_tmp_);
       enqueue_triangle_contact(u_tmp_, t1);
       launch(correct_, step_global_, step_local_);
     } else {
@@ -1071,7 +1109,9 @@ void Simulator::download(std::vector<double>& u, std::vector<double>& v) const {
 void Simulator::upload(const std::vector<double>& u, const std::vector<double>& v) {
   require(u.size() == 3 * n_ && v.size() == 3 * n_, "state size does not match the model");
   pending_ = false;  // the new state replaces the one the projection was for
-  if (volume_lag_)  // nor is the lagged multiplier that of the new state: start it at zero (all-zero bytes)
+  // nor is the lagged multiplier that of the new state: start it at zero (all-zero bytes; the
+  // constructor's upload comes before the buffer, which starts at zero)
+  if (volume_lag_ && vol_scalars_())
     cl_.queue.enqueueFillBuffer(vol_scalars_, cl_uchar(0), std::size_t(kVolumeScalars - 1) * real_size_, real_size_);
   if (precision_ == Precision::Double) {
     write_xyz<double>(u_, u, &inverse_mass_);

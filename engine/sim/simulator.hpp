@@ -171,6 +171,8 @@ class Simulator {
   bool lanes() const { return lanes_; }
   /// Heun's whole step runs as one launch (kernels/persistent.cl; NVIDIA GPUs, small models)
   bool persistent_step() const { return persistent_.on; }
+  /// Heun's two element stresses computed in one launch (kernels/hyperelastic.cl, VB_STRESS_PAIR)
+  bool stress_pair() const { return stress_pair_; }
   /// The kernel files and build options of this model's program (build_program), so that a test
   /// can build the variants a device here does not run (the one-launch step on PoCL).
   const std::vector<std::string>& kernel_files() const { return kernel_files_; }
@@ -202,6 +204,11 @@ class Simulator {
   /// scalars; none when null)
   void enqueue_stress(const cl::Buffer& u, const cl::Buffer* pending_grad = nullptr,
                       const cl::Buffer* pending_scalars = nullptr);
+  /// element stresses of (u_, v_) and of Heun's predicted stage u_ + dt·v_ in one launch (stress_pair_)
+  void enqueue_stress_pair();
+  /// Decides the launch schedule (volume launches, force split, lanes, one-launch step, lagged
+  /// pressure, paired stress) before anything is allocated: the arena depends on it.
+  void plan_launches(const Scene& scene, const ElementArrays& el, const ClContext& cl);
   void make_model_arena(const ElementArrays& el, const std::vector<cl_int>& grid, const std::vector<cl_uint>& cell_of,
                         std::size_t offset_bytes);
   std::vector<unsigned char> real_bytes(const std::vector<double>& values) const;  ///< in the model's precision
@@ -233,6 +240,7 @@ class Simulator {
   /// VB_UNPACK_LATTICE) and their offsets; E_, cell_, rest_offset_ are the host's views of three.
   DeviceArena arena_;
   cl_uint8 arena_at_{};
+  cl_uint8 arena_at_pred_{};  ///< arena_at_ with the predicted stage's Q and C (stress_pair_), for heun_correct
   cl::Buffer E_, cell_;
   bool hyper_ = false;
   cl::Buffer indenters_;  ///< rigid-obstacle table: indenters and tori (lattice frame)
@@ -296,6 +304,7 @@ class Simulator {
   std::size_t volume_triangles_ = 0, volume_surface_ = 0, volume_groups_ = 0;
   std::size_t volume_wg_ = 0;   ///< work-group size of volume_project (VB_VOLUME_WG)
   int volume_launches_ = 1;     ///< per projection: 1 volume_project, 2 volume_partials + volume_apply, 0 folded
+  bool stress_pair_ = false;  ///< Heun's two element stresses in one launch (VB_STRESS_PAIR)
   bool volume_lag_ = false;  ///< Heun's predicted stage under the lagged pressure, not projected
   DeviceArena vol_mesh_;  ///< triangles, surface elements, incident start, incident (kernels/volume.cl)
   cl_uint4 vol_mesh_at_{};

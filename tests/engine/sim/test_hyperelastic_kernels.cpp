@@ -3,7 +3,9 @@
 // hourglass control.
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -228,9 +230,9 @@ TEST(HyperelasticKernels, CheckerboardDecaysWithHourglassControlAndPersistsWitho
   EXPECT_GT(amplitude_after(0.0), 0.5) << "without it the checkerboard is a zero-energy mode";
 }
 
-/// u then v after 100 Heun steps of a sagging two-term Ogden block (double, dashpots) from a smooth
-/// deformation, with `split` work-items per element in the force passes (VOXBREAST_FORCE_SPLIT).
-std::vector<double> split_steps(int split) {
+/// A sagging two-term Ogden block (double, dashpots, Heun) held at its base; with the volume
+/// constraint when `volume` (its predicted stage under the lagged pressure, the default).
+Scene sagging_ogden_block(bool volume) {
   Scene s = hyper_block(7, ogden_two_term());
   s.solver.integrator = Integrator::Heun;
   s.solver.dashpot_ratio = 0.1;
@@ -238,14 +240,22 @@ std::vector<double> split_steps(int split) {
   s.gravity.active = true;
   s.gravity.acceleration_m_s2 = Vec3(0, 0, -9.81);
   s.anchors.push_back(test::halfspace_anchor("base", Vec3(0, 0, 0.001), Vec3(0, 0, -1)));
+  s.volume.preserve = volume;
+  return s;
+}
+
+/// u then v after 100 Heun steps of `s` from a smooth deformation, with the environment variable
+/// `env` set to `value` while the simulator is made; `check` sees the simulator then.
+std::vector<double> heun_steps_with(const Scene& s, const char* env, const std::string& value,
+                                    const std::function<void(const Simulator&)>& check) {
   const test::Model m = test::make_model(s);
   const auto u0 = field(m.lattice, [](const Vec3& X) {
     return Vec3(0.0002 * std::sin(300 * X.z()), 0.0001 * std::cos(400 * X.x()), -0.0002 * std::sin(250 * X.y()));
   });
-  setenv("VOXBREAST_FORCE_SPLIT", std::to_string(split).c_str(), 1);
+  setenv(env, value.c_str(), 1);
   Simulator sim(s, m.lattice, m.elements, test::cl_context());
-  unsetenv("VOXBREAST_FORCE_SPLIT");
-  EXPECT_EQ(sim.force_split(), split);
+  unsetenv(env);
+  check(sim);
   sim.upload(u0, std::vector<double>(u0.size(), 0.0));
   sim.advance(100);
   std::vector<double> u, v;
@@ -254,21 +264,69 @@ std::vector<double> split_steps(int split) {
   return u;
 }
 
+/// The largest difference between two trajectories, relative to the largest |value| of the first.
+double relative_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  EXPECT_EQ(a.size(), b.size());
+  double largest = 0, diff = 0;
+  for (double x : a) largest = std::max(largest, std::abs(x));
+  EXPECT_GT(largest, 0);
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) diff = std::max(diff, std::abs(a[i] - b[i]));
+  return diff / largest;
+}
+
+std::vector<double> split_steps(int split) {
+  return heun_steps_with(sagging_ogden_block(false), "VOXBREAST_FORCE_SPLIT", std::to_string(split),
+                         [&](const Simulator& sim) { EXPECT_EQ(sim.force_split(), split); });
+}
+
 // Each element's connections summed by 2 or 4 work-items that meet in local memory (343 elements:
 // the last work-group is partly empty): the same trajectory as one work-item per element up to the
 // order of the sums. A part left out, counted twice or read before it is written would not be.
 TEST(HyperelasticKernels, SplitForcePassesMatchOneWorkItemPerElement) {
   const std::vector<double> one = split_steps(1);
-  double largest = 0;
-  for (double x : one) largest = std::max(largest, std::abs(x));
-  ASSERT_GT(largest, 0);
-  for (const int split : {2, 4}) {
-    const std::vector<double> many = split_steps(split);
-    ASSERT_EQ(many.size(), one.size());
-    double diff = 0;
-    for (std::size_t i = 0; i < one.size(); ++i) diff = std::max(diff, std::abs(many[i] - one[i]));
-    EXPECT_LE(diff, 1e-12 * largest) << split << " work-items per element";
+  for (const int split : {2, 4})
+    EXPECT_LE(relative_difference(one, split_steps(split)), 1e-12) << split << " work-items per element";
+}
+
+// Heun's two element stresses in one launch, the predicted stage's read as u + dt·v (kernels/
+// hyperelastic.cl, VB_STRESS_PAIR), against two launches, the second reading the ũ heun_predict
+// stored: the same trajectory (held base elements included, which the predicted stage does not
+// move), with and without the volume constraint. A stress of the wrong stage (the pair's rows
+// swapped, or the corrector reading the current stage's Q and C) would be a different Heun step.
+TEST(HyperelasticKernels, PairedStressesMatchTwoLaunches) {
+  for (const bool volume : {false, true}) {
+    const Scene s = sagging_ogden_block(volume);
+    const auto two = heun_steps_with(s, "VOXBREAST_STRESS_PAIR", "0",
+                                     [](const Simulator& sim) { EXPECT_FALSE(sim.stress_pair()); });
+    const auto one = heun_steps_with(s, "VOXBREAST_STRESS_PAIR", "1",
+                                     [](const Simulator& sim) { EXPECT_TRUE(sim.stress_pair()); });
+    const double diff = relative_difference(two, one);
+    std::printf("volume %d: paired against two launches, max difference %.3g of the largest |u|, |v|\n", volume,
+                diff);
+    EXPECT_LE(diff, 1e-12) << (volume ? "with" : "without") << " the volume constraint";
   }
+}
+
+// Where something besides (u, v) moves the predicted stage, its stress is computed from the stored
+// ũ as before: an indenter projects ũ out of itself, and the volume constraint's own projection of
+// the predicted stage (predictor = "projection") moves its surface.
+TEST(HyperelasticKernels, PairedStressesOnlyWhereThePredictedStageIsUPlusDtV) {
+  Scene plain = sagging_ogden_block(false);
+  const test::Model m = test::make_model(plain);
+  EXPECT_TRUE(Simulator(plain, m.lattice, m.elements, test::cl_context()).stress_pair());
+  Scene projected = sagging_ogden_block(true);
+  projected.volume.predictor = VolumeSpec::Predictor::Projection;
+  EXPECT_FALSE(Simulator(projected, m.lattice, m.elements, test::cl_context()).stress_pair());
+  Scene indented = plain;
+  IndenterSpec sphere;
+  sphere.radius_m = 0.003;
+  sphere.start_m = Vec3(0.007, 0.007, 0.02);
+  sphere.velocity_m_s = Vec3(0, 0, -0.01);
+  indented.indenters.push_back(sphere);
+  EXPECT_FALSE(Simulator(indented, m.lattice, m.elements, test::cl_context()).stress_pair());
+  Scene euler = plain;
+  euler.solver.integrator = Integrator::SymplecticEuler;
+  EXPECT_FALSE(Simulator(euler, m.lattice, m.elements, test::cl_context()).stress_pair());
 }
 
 }  // namespace
