@@ -116,7 +116,7 @@ void heun_step_persistent(global real4* u, global real4* v, global real4* u_pred
                           real4 gravity, real damping, real4 origin, real hourglass, global const real* indenters,
                           real t0, real t1, real dt, uint n, global const real4* rest_frame,
 #if VB_VOLUME
-                          global const uchar* mesh, uint4 mesh_at, uint n_triangles, uint n_surface, real4 centre,
+                          global const uchar* mesh, uint4 mesh_at, uint n_surface, real4 centre,
                           global real4* grad, global real* partial, uint vol_groups, real rest_volume,
                           global real* scalars, int project,
 #endif

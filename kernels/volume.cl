@@ -3,8 +3,10 @@
 // surface elements. Compiled only when the scene sets [volume] preserve = true (-DVB_VOLUME=1).
 // All positions are in the lattice frame (rest_position + u), where V carries det(rotation).
 //
-//   volume_partials: per work-group partial sums (VB_VOLUME_SLOTS reals per group)
-//     0  Σ x0·(x1 × x2) over triangles (= 6V, positions relative to `centre`)
+//   volume_partials: per work-group partial sums (VB_VOLUME_SLOTS reals per group), one work-item
+//   per surface element s
+//     0  Σ x_s·g_s·2 (= 6V, positions relative to `centre`: V is homogeneous of degree 3 in them,
+//        so Σ x_s·∂V/∂x_s = 3V by Euler's theorem; no pass over the triangles of its own)
 //     1  Σ w|g|² over surface elements (w = 1/m, 0 for held elements)
 //     2  Σ g·v over surface elements (the rate dV/dt)
 //     3  Σ |g|² over free surface elements   4  Σ g·f over free surface elements (with_force only)
@@ -50,20 +52,14 @@ inline void sum_over_group(local real* s, uint wg, const real* value, uint l) {
   }
 }
 
-// Work-item i's share of the partial sums: triangle i's 6V, and surface element i's terms, whose
-// gradient g it writes to `grad`.
+// Work-item i's share of the partial sums: surface element i's terms, whose gradient g it writes
+// to `grad`.
 inline void volume_item_values(uint i, global const real4* u, global const real4* v, VB_LATTICE_PARAMS,
-                               global const uint* triangles, uint n_triangles,
+                               global const uint* triangles,
                                global const uint* surface_elements, global const uint* incident_start,
                                global const VB_INCIDENT* incident, uint n_surface, real4 centre,
                                global real4* grad, int with_force, real value[VB_VOLUME_SLOTS]) {
   for (int k = 0; k < VB_VOLUME_SLOTS; ++k) value[k] = 0;
-  if (i < n_triangles) {
-    const real4 a = element_position(triangles[3 * i], u, cell_of, sy, sz, origin, h, centre);
-    const real4 b = element_position(triangles[3 * i + 1], u, cell_of, sy, sz, origin, h, centre);
-    const real4 c = element_position(triangles[3 * i + 2], u, cell_of, sy, sz, origin, h, centre);
-    value[0] = dot3(a, cross(b, c));
-  }
   if (i < n_surface) {
     const uint e = surface_elements[i];
     // ∂(x0·(x1 × x2))/∂x0 = x1 × x2, cyclically. With VB_VOLUME_PAIRS incident[] holds, per
@@ -84,6 +80,8 @@ inline void volume_item_values(uint i, global const real4* u, global const real4
       const real4 c = element_position(bc.y, u, cell_of, sy, sz, origin, h, centre);
       g += cross(b, c);
     }
+    // each incident triangle's x0·(x1 × x2) once per corner: Σ_s x_s·(6g_s) = 3·6V
+    value[0] = dot3(element_position(e, u, cell_of, sy, sz, origin, h, centre), g) / (real)3;
     g = xyz0(g) / (real)6;
     grad[e] = g;
     const real4 ui = u[e];
@@ -98,13 +96,13 @@ inline void volume_item_values(uint i, global const real4* u, global const real4
 }
 
 #define VB_VOLUME_MESH_PARAMS                                                                   \
-  global const uint *triangles, uint n_triangles, global const uint *surface_elements,          \
+  global const uint *triangles, global const uint *surface_elements,                            \
       global const uint *incident_start, global const VB_INCIDENT *incident, uint n_surface, real4 centre
-#define VB_VOLUME_MESH_ARGS triangles, n_triangles, surface_elements, incident_start, incident, n_surface, centre
+#define VB_VOLUME_MESH_ARGS triangles, surface_elements, incident_start, incident, n_surface, centre
 // What kernels take instead: the mesh's arrays in one buffer (engine/sim/device_arena.hpp), their
 // offsets in `mesh_at` (triangles, surface elements, incident start, incident).
 #define VB_VOLUME_MESH_KERNEL_PARAMS \
-  global const uchar *mesh, uint4 mesh_at, uint n_triangles, uint n_surface, real4 centre
+  global const uchar *mesh, uint4 mesh_at, uint n_surface, real4 centre
 #define VB_UNPACK_SURFACE \
   global const uint* surface_elements = (global const uint*)VB_ARENA_AT(mesh, mesh_at.s1)
 #define VB_UNPACK_MESH                                                                       \

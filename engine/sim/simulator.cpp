@@ -40,8 +40,8 @@ constexpr int kTriangleArgs = 4;
 constexpr int kCheckVolume = kCheckIndenter + kIndenterArgs + 3;  // VB_VOLUME: grad, scalars
 // kernels/volume.cl: volume_partials takes u, v, the lattice parameters, then these.
 constexpr int kVolumeSlots = 5, kVolumeScalars = 5;  // scalars: λ, μ, V, p, M (kernels/volume.cl)
-constexpr int kVolumeMesh = 2 + kLatticeArgs;  // mesh arena, its offsets, n_tri, n_surf
-constexpr int kVolumeCentre = kVolumeMesh + 4, kVolumeWithForce = kVolumeMesh + 6;
+constexpr int kVolumeMesh = 2 + kLatticeArgs;  // mesh arena, its offsets, n_surf
+constexpr int kVolumeCentre = kVolumeMesh + 3, kVolumeWithForce = kVolumeMesh + 5;
 // volume_project: u, v, the lattice parameters, the mesh, centre, then grad, partial, V0, scalars, count
 constexpr int kProjectGrad = kVolumeCentre + 1, kProjectRestVolume = kVolumeCentre + 3;
 // volume_apply: u, v, mesh arena, its offsets, n_surface, grad, partial, groups, V0, scalars
@@ -79,7 +79,7 @@ std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Prec
 std::size_t estimated_volume_device_bytes(std::size_t elements, std::size_t surface_elements, std::size_t triangles,
                                           Precision precision) {
   const std::size_t real = precision == Precision::Double ? 8 : 4;
-  const std::size_t groups = (std::max(surface_elements, triangles) + kCheckWorkGroup - 1) / kCheckWorkGroup;
+  const std::size_t groups = (surface_elements + kCheckWorkGroup - 1) / kCheckWorkGroup;  // one item per surface element
   return triangles * 3 * 4                       // triangle corners (element ids)
          + surface_elements * 4 + (surface_elements + 1) * 4 + triangles * 3 * 8  // CSR of incident corners (pairs)
          + elements * 4 * real                   // gradient per element
@@ -489,9 +489,9 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
     incident = std::move(pairs);
   }
 
-  volume_triangles_ = mesh.triangles.size();
   volume_surface_ = surface.size();
-  volume_groups_ = (std::max(volume_triangles_, volume_surface_) + kCheckWorkGroup - 1) / kCheckWorkGroup;
+  // one work-item per surface element (kernels/volume.cl: the volume from Euler's theorem)
+  volume_groups_ = (volume_surface_ + kCheckWorkGroup - 1) / kCheckWorkGroup;
   frame_sign_ = lattice_.rotation.determinant() < 0 ? -1.0 : 1.0;
   rest_volume_m3_ = double(mesh.complete_cell_count) * std::pow(lattice_.spacing_m, 3);
   Vec3 centre = Vec3::Zero();  // positions are taken relative to it, to keep rounding small
@@ -521,8 +521,7 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
     set_lattice_args(k, 2);
     k.setArg(kVolumeMesh + 0, vol_mesh_.buffer());
     k.setArg(kVolumeMesh + 1, vol_mesh_at_);
-    k.setArg(kVolumeMesh + 2, cl_uint(volume_triangles_));
-    k.setArg(kVolumeMesh + 3, cl_uint(volume_surface_));
+    k.setArg(kVolumeMesh + 2, cl_uint(volume_surface_));
     set_world_vector(k, kVolumeCentre, centre);
     k.setArg(kVolumeCentre + 1, vol_grad_);
     return k;
@@ -628,7 +627,7 @@ void Simulator::enqueue_volume_correction(const cl::Buffer& u, const cl::Buffer&
   if (volume_launches_ == 1) {  // sums, λ and μ, and the projection in one launch
     vol_project_.setArg(0, u);
     vol_project_.setArg(1, v);
-    const std::size_t groups = (std::max(volume_triangles_, volume_surface_) + volume_wg_ - 1) / volume_wg_;
+    const std::size_t groups = (volume_surface_ + volume_wg_ - 1) / volume_wg_;
     launch(vol_project_, cl::NDRange(groups * volume_wg_), cl::NDRange(volume_wg_));
     return;
   }

@@ -301,7 +301,7 @@ class Simulator {
   bool volume_ = false;
   SurfaceMesh surface_;
   double rest_volume_m3_ = 0, frame_sign_ = 1;  ///< det(rotation): lattice-frame V = sign·V_world
-  std::size_t volume_triangles_ = 0, volume_surface_ = 0, volume_groups_ = 0;
+  std::size_t volume_surface_ = 0, volume_groups_ = 0;
   std::size_t volume_wg_ = 0;   ///< work-group size of volume_project (VB_VOLUME_WG)
   int volume_launches_ = 1;     ///< per projection: 1 volume_project, 2 volume_partials + volume_apply, 0 folded
   bool stress_pair_ = false;  ///< Heun's two element stresses in one launch (VB_STRESS_PAIR)

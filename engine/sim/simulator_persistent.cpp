@@ -11,9 +11,9 @@ namespace vb {
 namespace {
 
 // heun_step_persistent's arguments (kernels/persistent.cl): u, v, ũ, ṽ, the lattice (10), the
-// obstacles, t0, t1, dt, n, rest frames; with the volume constraint 11 more; then sync, target.
+// obstacles, t0, t1, dt, n, rest frames; with the volume constraint 10 more; then sync, target.
 constexpr int kLattice = 4, kIndenters = kLattice + 10, kDt = kIndenters + 3, kRestFrame = kDt + 2;
-constexpr int kMesh = kRestFrame + 1, kRestVolume = kMesh + 8, kProject = kMesh + 10;
+constexpr int kMesh = kRestFrame + 1, kRestVolume = kMesh + 7, kProject = kMesh + 9;
 constexpr int kSyncWords = 2 + 12;  // count, fault flag, VB_PERSISTENT_TRACE's stamps (≤ 9 barriers + 2)
 /// the sync buffer's argument; the launch's first barrier target follows it
 constexpr int sync_arg(bool volume) { return volume ? kProject + 1 : kMesh; }
@@ -39,13 +39,12 @@ void Simulator::make_persistent_kernel() {
   if (volume_) {
     k.setArg(kMesh, vol_mesh_.buffer());
     k.setArg(kMesh + 1, vol_mesh_at_);
-    k.setArg(kMesh + 2, cl_uint(volume_triangles_));
-    k.setArg(kMesh + 3, cl_uint(volume_surface_));
-    set_world_vector(k, kMesh + 4, vol_centre_);
-    k.setArg(kMesh + 5, vol_grad_);
-    k.setArg(kMesh + 6, vol_partial_);
-    k.setArg(kMesh + 7, cl_uint(volume_groups_));
-    k.setArg(kMesh + 9, vol_scalars_);
+    k.setArg(kMesh + 2, cl_uint(volume_surface_));
+    set_world_vector(k, kMesh + 3, vol_centre_);
+    k.setArg(kMesh + 4, vol_grad_);
+    k.setArg(kMesh + 5, vol_partial_);
+    k.setArg(kMesh + 6, cl_uint(volume_groups_));
+    k.setArg(kMesh + 8, vol_scalars_);
     set_rest_volume_args();  // V0 (kRestVolume), where every projecting kernel gets it
   }
   const cl_uint zeros[kSyncWords] = {};  // barrier count, fault flag, trace stamps

@@ -1,7 +1,9 @@
 #pragma once
 // Helpers for simulator tests: scenes built in code and one OpenCL context per test binary.
 #include <cmath>
+#include <cstdlib>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "engine/lattice/voxelise.hpp"
@@ -10,6 +12,18 @@
 #include "engine/sim/opencl_runtime.hpp"
 
 namespace vb::test {
+
+/// Sets an environment variable (the simulator's VOXBREAST_* switches) for its lifetime, so that a
+/// failed assertion or an exception does not leave it set for the next test.
+struct ScopedEnv {
+  ScopedEnv(const char* name, const std::string& value) : name_(name) { setenv(name, value.c_str(), 1); }
+  ~ScopedEnv() { unsetenv(name_); }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  const char* name_;
+};
 
 /// The default device (PoCL in CI), created once.
 inline const ClContext& cl_context() {

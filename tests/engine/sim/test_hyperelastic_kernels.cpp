@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <memory>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -252,9 +253,12 @@ std::vector<double> heun_steps_with(const Scene& s, const char* env, const std::
   const auto u0 = field(m.lattice, [](const Vec3& X) {
     return Vec3(0.0002 * std::sin(300 * X.z()), 0.0001 * std::cos(400 * X.x()), -0.0002 * std::sin(250 * X.y()));
   });
-  setenv(env, value.c_str(), 1);
-  Simulator sim(s, m.lattice, m.elements, test::cl_context());
-  unsetenv(env);
+  auto sim_with = [&] {
+    const test::ScopedEnv set(env, value);
+    return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
+  };
+  const std::unique_ptr<Simulator> made = sim_with();
+  Simulator& sim = *made;
   check(sim);
   sim.upload(u0, std::vector<double>(u0.size(), 0.0));
   sim.advance(100);
