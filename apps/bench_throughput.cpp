@@ -318,7 +318,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                                                : sim.volume_predictor_pressure() ? nlohmann::json("pressure")
                                                                                  : nlohmann::json("projection")},
                           {"force_split", sim.force_split()}, {"persistent_step", sim.persistent_step()},
-                          {"stress_pair", sim.stress_pair()},
+                          {"stress_pair", sim.stress_pair()}, {"stress_pass_elements", sim.stress_pass_elements()},
                           {"lanes_kernels", sim.lanes()}};
     csv << c.name << "," << n << "," << c.law << "," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)

@@ -388,16 +388,24 @@ inline void element_stress_one(uint e, global const real4* u, global uchar* aren
 // With VB_STRESS_PAIR (Heun), a launch over two rows of work-items computes both stages' stresses:
 // row 0 that of u into Q, C (slots 5, 6), row 1 that of the predicted stage u + dt·v into the
 // arena's slots pred_at (what heun_correct reads). One row is the stress of u alone (checks).
+// In the step, with list_n > 0, work-item i takes element list[i] of the arena's list at list_at:
+// only the elements some free element reads (Simulator, elements_read_by_free).
 kernel void element_stress(global const real4* u, global uchar* arena, uint8 at, int sy, int sz, real h, uint n,
                            global const real4* rest_frame
 #if VB_VOLUME_FOLD
                            , global const real4* pend_g, global const real* pend_scalars
 #endif
 #if VB_STRESS_PAIR
-                           , global const real4* v, real dt, uint2 pred_at
+                           , global const real4* v, real dt, uint2 pred_at, uint list_at, uint list_n
 #endif
 ) {
-  const uint e = get_global_id(0);
+  uint e = get_global_id(0);
+#if VB_STRESS_PAIR
+  if (list_n) {
+    if (e >= list_n) return;
+    e = ((global const uint*)VB_ARENA_AT(arena, list_at))[e];
+  }
+#endif
   if (e >= n) return;
 #if VB_STRESS_PAIR
   if (get_global_id(1) == 1) {

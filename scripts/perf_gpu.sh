@@ -11,9 +11,10 @@
 #   VOXBREAST_FORCE_SPLIT=1|2|4      work-items per element in Heun's force passes (GPU default 2
 #                                    for hyperelastic models up to 262,144 elements)
 #   --volume-predictor projection    the volume rows with Heun's predicted stage projected (change 15)
+#   VOXBREAST_STRESS_PAIR=0          both element stresses of a Heun step in two launches (change 16)
 #   VOXBREAST_PERSISTENT=0|1         Heun's step as one launch with grid barriers (NVIDIA default
 #                                    for spring models up to 262,144 elements; the 36k rows run
-#                                    the default and =0, the target row also =1)
+#                                    the default and =0)
 #   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
 #   device: bash scripts/perf_gpu.sh      (run tool, carry [".device-pkgs"]; writes $OUT/perf)
 set -uo pipefail
@@ -56,7 +57,8 @@ for round in 1 2; do
 done
 # the breast phantom at 3.2 mm (34,961 elements, a third of them moving) next to the cube
 row 36k_breast voxbreast --breast --sizes 33 --laws linear neo-hookean ogden --volume
-VOXBREAST_PERSISTENT=1 row 36k_persistent voxbreast --sizes 33 --laws ogden --volume
+# both of Heun's element stresses in two launches instead of one (PERF_NOTES.md change 16)
+VOXBREAST_STRESS_PAIR=0 row 36k_breast_nopair voxbreast --breast --sizes 33 --laws ogden --volume
 VOXBREAST_FORCE_SPLIT=1 row 36k_split1 voxbreast --sizes 33 --laws ogden --volume
 VOXBREAST_FORCE_SPLIT=4 row 36k_split4 voxbreast --sizes 33 --laws ogden --volume
 row 1.5M voxbreast --sizes 115 --laws ogden

@@ -70,6 +70,19 @@ std::string mib(double bytes) { return std::to_string(static_cast<long long>(byt
 
 }  // namespace
 
+/// The elements whose element stress some free element reads in a step: the free ones (their own
+/// Q) and every neighbour of one (Q·h·d and the hourglass term's C). A held element deep in the
+/// held region is read by nobody.
+std::vector<cl_uint> elements_read_by_free(const Lattice& lattice, const std::vector<double>& inverse_mass) {
+  std::vector<cl_uint> list;
+  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+    bool read = inverse_mass[e] != 0;
+    for (const std::int32_t j : lattice.neighbours(e)) read = read || (j >= 0 && inverse_mass[std::size_t(j)] != 0);
+    if (read) list.push_back(cl_uint(e));
+  }
+  return list;
+}
+
 std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision, bool hyperelastic) {
   const std::size_t real = precision == Precision::Double ? 8 : 4;
   const std::size_t hyper = hyperelastic ? 4 * 4 * real + 1 : 0;  // Q rows and C (hyper_store), tissue id
@@ -290,6 +303,8 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
       stress_.setArg(8, v_);
       set_real(stress_, 9, dt_.dt_s);
       stress_.setArg(10, cl_uint2{{arena_at_pred_.s[5], arena_at_pred_.s[6]}});
+      stress_.setArg(11, stress_list_at_);
+      stress_.setArg(12, cl_uint(0));  // every element, until the step's launch (enqueue_stress_pair)
     }
   }
 
@@ -690,6 +705,11 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
   // The predicted stage's Q and C (stress_pair_): what heun_correct reads in place of slots 5 and 6.
   const std::size_t pred_q = stress_pair_ ? arena_.add(nullptr, 3 * row_bytes) : 0;
   const std::size_t pred_c = stress_pair_ ? arena_.add(nullptr, row_bytes) : 0;
+  // The step's stress pass skips held elements that no free element reads (stress_list_).
+  const std::vector<cl_uint> list = stress_pair_ ? elements_read_by_free(lattice_, inverse_mass_) : std::vector<cl_uint>{};
+  stress_list_n_ = list.size() < n_ ? list.size() : 0;
+  const std::size_t list_slot = stress_list_n_ ? arena_.add(list.data(), list.size() * sizeof(cl_uint)) : 0;
+  device_bytes_ += stress_list_n_ * sizeof(cl_uint);
   require(arena_.bytes() <= cl_.info.max_allocation_bytes,
           "the model's arrays need one buffer of " + mib(double(arena_.bytes())) + " but '" + cl_.info.name +
               "' allocates at most " + mib(double(cl_.info.max_allocation_bytes)),
@@ -701,6 +721,7 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
     arena_at_pred_.s[5] = arena_.offset_units(pred_q);
     arena_at_pred_.s[6] = arena_.offset_units(pred_c);
   }
+  stress_list_at_ = stress_list_n_ ? arena_.offset_units(list_slot) : 0;
   E_ = arena_.part(slot[0]);
   cell_ = arena_.part(slot[1]);
   rest_offset_ = arena_.part(slot[7]);
@@ -904,10 +925,14 @@ void Simulator::enqueue_stress(const cl::Buffer& u, const cl::Buffer* pending_gr
 }
 
 void Simulator::enqueue_stress_pair() {
-  // Heun's two stages as two rows of work-items (kernels/hyperelastic.cl, element_stress)
+  // Heun's two stages as two rows of work-items (kernels/hyperelastic.cl, element_stress), over
+  // the stress list where it leaves elements out
   stress_.setArg(0, u_);
+  stress_.setArg(12, cl_uint(stress_list_n_));
+  const std::size_t wg = kCheckWorkGroup, items = stress_list_n_ ? (stress_list_n_ + wg - 1) / wg * wg : global_[0];
   const cl::NDRange local = local_.dimensions() ? cl::NDRange(local_[0], 1) : cl::NullRange;
-  launch(stress_, cl::NDRange(global_[0], 2), local);
+  launch(stress_, cl::NDRange(items, 2), local);
+  stress_.setArg(12, cl_uint(0));  // other stress passes (checks, host requests) cover every element
 }
 
 void Simulator::enqueue_check() const {

@@ -173,6 +173,9 @@ class Simulator {
   bool persistent_step() const { return persistent_.on; }
   /// Heun's two element stresses computed in one launch (kernels/hyperelastic.cl, VB_STRESS_PAIR)
   bool stress_pair() const { return stress_pair_; }
+  /// The elements whose stresses that launch computes: those some free element reads (a held
+  /// element deep in the held region is left out), or every element.
+  std::size_t stress_pass_elements() const { return stress_list_n_ ? stress_list_n_ : n_; }
   /// The kernel files and build options of this model's program (build_program), so that a test
   /// can build the variants a device here does not run (the one-launch step on PoCL).
   const std::vector<std::string>& kernel_files() const { return kernel_files_; }
@@ -241,6 +244,10 @@ class Simulator {
   DeviceArena arena_;
   cl_uint8 arena_at_{};
   cl_uint8 arena_at_pred_{};  ///< arena_at_ with the predicted stage's Q and C (stress_pair_), for heun_correct
+  /// stress_pair_: the elements the step's stress pass covers (elements_read_by_free, in the arena
+  /// at stress_list_at_), 0 when that is every element
+  std::size_t stress_list_n_ = 0;
+  cl_uint stress_list_at_ = 0;
   cl::Buffer E_, cell_;
   bool hyper_ = false;
   cl::Buffer indenters_;  ///< rigid-obstacle table: indenters and tori (lattice frame)
