@@ -70,6 +70,8 @@ std::string mib(double bytes) { return std::to_string(static_cast<long long>(byt
 
 }  // namespace
 
+namespace {
+
 /// The elements whose element stress some free element reads in a step: the free ones (their own
 /// Q) and every neighbour of one (Q·h·d and the hourglass term's C). A held element deep in the
 /// held region is read by nobody.
@@ -82,6 +84,8 @@ std::vector<cl_uint> elements_read_by_free(const Lattice& lattice, const std::ve
   }
   return list;
 }
+
+}  // namespace
 
 std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision, bool hyperelastic) {
   const std::size_t real = precision == Precision::Double ? 8 : 4;
@@ -705,7 +709,7 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
   // The predicted stage's Q and C (stress_pair_): what heun_correct reads in place of slots 5 and 6.
   const std::size_t pred_q = stress_pair_ ? arena_.add(nullptr, 3 * row_bytes) : 0;
   const std::size_t pred_c = stress_pair_ ? arena_.add(nullptr, row_bytes) : 0;
-  // The step's stress pass skips held elements that no free element reads (stress_list_).
+  // The step's stress pass skips held elements that no free element reads (stress_list_n_).
   const std::vector<cl_uint> list = stress_pair_ ? elements_read_by_free(lattice_, inverse_mass_) : std::vector<cl_uint>{};
   stress_list_n_ = list.size() < n_ ? list.size() : 0;
   const std::size_t list_slot = stress_list_n_ ? arena_.add(list.data(), list.size() * sizeof(cl_uint)) : 0;

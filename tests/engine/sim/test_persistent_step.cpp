@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -113,15 +114,17 @@ TEST(PersistentStep, KernelBuildsOnEveryDevice) {
     for (const char* split : {"1", "2"}) {
       const Scene s = make_case(c);
       const test::Model m = test::make_model(s);
-      setenv("VOXBREAST_FORCE_SPLIT", split, 1);
-      const Simulator sim(s, m.lattice, m.elements, test::cl_context());
-      unsetenv("VOXBREAST_FORCE_SPLIT");
-      std::string options = sim.build_options();
+      std::unique_ptr<Simulator> sim;
+      {
+        const test::ScopedEnv set("VOXBREAST_FORCE_SPLIT", split);
+        sim = std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
+      }
+      std::string options = sim->build_options();
       const std::string off = "-DVB_PERSISTENT=0";
       const std::size_t at = options.find(off);
       if (at != std::string::npos) options.replace(at, off.size(), "-DVB_PERSISTENT=1 -DVB_PERSISTENT_TRACE=0");
       ASSERT_NE(options.find("-DVB_PERSISTENT=1"), std::string::npos) << options;
-      EXPECT_NO_THROW(build_program(test::cl_context(), sim.kernel_files(), lattice_tables_source(), options))
+      EXPECT_NO_THROW(build_program(test::cl_context(), sim->kernel_files(), lattice_tables_source(), options))
           << "case " << int(c) << ", split " << split;
     }
 }
