@@ -11,12 +11,14 @@
 // volume_lag_; docs/PHYSICS.md, "Volume preservation"): instead of a projection of its own, the
 // stage feels the force −(M/dt)·g on each free surface element, g the volume gradient and M the
 // multiplier the last corrections left (kernels/volume.cl: M ← μ + M/2), so at a constrained
-// equilibrium ṽ = v + dt·w·(f − p·g) = 0, as with the projection. lag_force is that force; with
-// `lag` 0 (a constant at each call) it is zero and costs nothing.
+// equilibrium ṽ = v + dt·w·(f − p·g) = 0, as with the projection. less_lag subtracts that force
+// from the lattice force f, as one fused multiply-add, so that the CPU lanes kernels
+// (integrate_lanes.cl), which do it on scalar components, round it identically whatever the
+// compiler contracts; with `lag` 0 (a constant at each call) it costs nothing.
 #define VB_LAG_PARAMS int lag, global const real4 *lag_g, real lag_p
 #define VB_LAG_ARGS lag, lag_g, lag_p
 #define VB_NO_LAG 0, (global const real4*)0, (real)0
-VB_INLINE real4 lag_force(uint e, VB_LAG_PARAMS) { return lag ? lag_p * lag_g[e] : (real4)(0); }
+VB_INLINE real4 less_lag(real4 f, uint e, VB_LAG_PARAMS) { return lag ? fma((real4)(-lag_p), lag_g[e], f) : f; }
 // heun_predict's own arguments: the gradient and the volume scalars {λ, μ, V, p, M}.
 #if VB_VOLUME_LAG
 #define VB_LAG_KERNEL_PARAMS , global const real4 *lag_g, global const real *lag_scalars
@@ -146,8 +148,8 @@ VB_INLINE void explicit_stage(uint e, global const real4* u, global const real4*
   pending_u(&ui, &wg, e, VB_PENDING_ARGS);
   pending_v(&vi, wg, VB_PENDING_ARGS);
   if (ui.w != 0) {
-    const real4 f = lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, 0, 26) -
-                    lag_force(e, VB_LAG_ARGS);
+    const real4 f =
+        less_lag(lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, 0, 26), e, VB_LAG_ARGS);
     explicit_update(e, &ui, &vi, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, symplectic VB_TRI_ARGS);
   }
   u_out[e] = ui;
@@ -191,7 +193,7 @@ VB_INLINE void predict_element(uint e, global const real4* u, global const real4
   const real4 f = split_lattice_force(in && ui.w != 0, e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, share);
   if (!in || get_local_id(0) >= VB_SPLIT_PER) return;
   if (ui.w != 0)
-    explicit_update(e, &ui, &vi, f - lag_force(e, VB_LAG_ARGS), VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, 0 VB_TRI_ARGS);
+    explicit_update(e, &ui, &vi, less_lag(f, e, VB_LAG_ARGS), VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, 0 VB_TRI_ARGS);
   u_pred[e] = ui;
   v_pred[e] = vi;
 #else

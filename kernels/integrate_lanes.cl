@@ -130,14 +130,14 @@ VB_INLINE void lane_explicit_stage(global const real4* u4, global const real4* v
   global const real* v = (global const real*)v4;
   const lane3 ui = lane_xyz(u, e, one), vi = lane_xyz(v, e, one);
   const real wi = lane_w(u, e, one), vw = lane_w(v, e, one);
-  lane3 a = lane_acceleration(
-      lane_lattice_force(e, ui, wi, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio, one), wi, vi, gravity, damping);
-  if (lag) {  // Heun's predicted stage under the lagged constraint pressure (integrate.cl, lag_force)
+  lane3 f = lane_lattice_force(e, ui, wi, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio, one);
+  if (lag) {  // Heun's predicted stage under the lagged constraint pressure: integrate.cl's less_lag
     const lane3 g = lane_xyz((global const real*)lag_g, e, one);
-    a.x -= lag_p * wi * g.x;
-    a.y -= lag_p * wi * g.y;
-    a.z -= lag_p * wi * g.z;
+    f.x = fma(-lag_p, g.x, f.x);
+    f.y = fma(-lag_p, g.y, f.y);
+    f.z = fma(-lag_p, g.z, f.z);
   }
+  lane3 a = lane_acceleration(f, wi, vi, gravity, damping);
   if (relax) {
     const real scale = relax_scale[e];
     const lane3 fictitious = {a.x * scale - c * vi.x, a.y * scale - c * vi.y, a.z * scale - c * vi.z};

@@ -13,7 +13,7 @@
 //   and g = ∂V/∂x of every surface element into `grad` (indexed by element).
 //   volume_finish: one work-group; scalars = {λ, μ, V, p}: λ = (V0 − V)/Σw|g|², μ = Σg·v/Σw|g|²,
 //     p = Σg·f/Σ|g|² (the pressure the check subtracts from the residual).
-//   With VB_VOLUME_LAG (Heun; kernels/integrate.cl, lag_force) the corrections (volume_apply,
+//   With VB_VOLUME_LAG (Heun; kernels/integrate.cl, less_lag) the corrections (volume_apply,
 //     volume_project) also update scalars[4], the multiplier M ← μ + M/2 whose pressure M/dt the
 //     next predicted stage feels: at a constrained equilibrium μ = dt·p − M/2, so M = dt·p is the
 //     fixed point, reached in one step once the motion is quasi-static.

@@ -16,6 +16,7 @@
 #include "engine/sim/host_reference.hpp"
 #include "engine/sim/simulator.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
+#include "tests/engine/sim/trajectory_compare.hpp"
 
 namespace vb {
 namespace {
@@ -269,16 +270,6 @@ std::vector<double> heun_steps_with(const Scene& s, const char* env, const std::
   return u;
 }
 
-/// The largest difference between two trajectories, relative to the largest |value| of the first.
-double relative_difference(const std::vector<double>& a, const std::vector<double>& b) {
-  EXPECT_EQ(a.size(), b.size());
-  double largest = 0, diff = 0;
-  for (double x : a) largest = std::max(largest, std::abs(x));
-  EXPECT_GT(largest, 0);
-  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) diff = std::max(diff, std::abs(a[i] - b[i]));
-  return diff / largest;
-}
-
 std::vector<double> split_steps(int split) {
   return heun_steps_with(sagging_ogden_block(false), "VOXBREAST_FORCE_SPLIT", std::to_string(split),
                          [&](const Simulator& sim) { EXPECT_EQ(sim.force_split(), split); });
@@ -290,7 +281,7 @@ std::vector<double> split_steps(int split) {
 TEST(HyperelasticKernels, SplitForcePassesMatchOneWorkItemPerElement) {
   const std::vector<double> one = split_steps(1);
   for (const int split : {2, 4})
-    EXPECT_LE(relative_difference(one, split_steps(split)), 1e-12) << split << " work-items per element";
+    EXPECT_LE(test::relative_difference(split_steps(split), one), 1e-12) << split << " work-items per element";
 }
 
 // Heun's two element stresses in one launch, the predicted stage's read as u + dt·v (kernels/
@@ -309,7 +300,7 @@ TEST(HyperelasticKernels, PairedStressesMatchTwoLaunches) {
       EXPECT_TRUE(sim.stress_pair());
       EXPECT_EQ(sim.stress_pass_elements(), 5u * 7 * 7);
     });
-    const double diff = relative_difference(two, one);
+    const double diff = test::relative_difference(one, two);
     std::printf("volume %d: paired against two launches, max difference %.3g of the largest |u|, |v|\n", volume,
                 diff);
     EXPECT_LE(diff, 1e-12) << (volume ? "with" : "without") << " the volume constraint";
