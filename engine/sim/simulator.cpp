@@ -299,17 +299,26 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   kernel_files_ = sources;
   build_options_ = options;
   if (hyper_) {
-    stress_ = cl::Kernel(program_, "element_stress");
-    set_element_fit_args(stress_);
-    stress_.setArg(6, cl_uint(n_));
-    stress_.setArg(7, rest_frame_);
-    if (stress_pair_) {  // kernels/hyperelastic.cl: v, dt and where the predicted stage's Q and C go
-      stress_.setArg(8, v_);
-      set_real(stress_, 9, dt_.dt_s);
-      stress_.setArg(10, cl_uint2{{arena_at_pred_.s[5], arena_at_pred_.s[6]}});
-      stress_.setArg(11, stress_list_at_);
-      stress_.setArg(12, cl_uint(0));  // every element, until the step's launch (enqueue_stress_pair)
-    }
+    // the stress of any u over every element (checks, host requests), and with stress_pair_ the
+    // step's launch of both stages over the stress list (kernels/hyperelastic.cl: v, dt, where the
+    // predicted stage's Q and C go, the list), all of whose arguments are set once
+    const auto stress_kernel = [&](cl_uint list_n) {
+      cl::Kernel k(program_, "element_stress");
+      set_element_fit_args(k);
+      k.setArg(0, u_);
+      k.setArg(6, cl_uint(n_));
+      k.setArg(7, rest_frame_);
+      if (stress_pair_) {
+        k.setArg(8, v_);
+        set_real(k, 9, dt_.dt_s);
+        k.setArg(10, cl_uint2{{arena_at_pred_.s[5], arena_at_pred_.s[6]}});
+        k.setArg(11, stress_list_at_);
+        k.setArg(12, list_n);
+      }
+      return k;
+    };
+    stress_ = stress_kernel(0);
+    if (stress_pair_) step_stress_ = stress_kernel(cl_uint(stress_list_n_));
   }
 
   const bool heun = scene.solver.integrator == Integrator::Heun;
@@ -931,12 +940,9 @@ void Simulator::enqueue_stress(const cl::Buffer& u, const cl::Buffer* pending_gr
 void Simulator::enqueue_stress_pair() {
   // Heun's two stages as two rows of work-items (kernels/hyperelastic.cl, element_stress), over
   // the stress list where it leaves elements out
-  stress_.setArg(0, u_);
-  stress_.setArg(12, cl_uint(stress_list_n_));
   const std::size_t wg = kCheckWorkGroup, items = stress_list_n_ ? (stress_list_n_ + wg - 1) / wg * wg : global_[0];
   const cl::NDRange local = local_.dimensions() ? cl::NDRange(local_[0], 1) : cl::NullRange;
-  launch(stress_, cl::NDRange(items, 2), local);
-  stress_.setArg(12, cl_uint(0));  // other stress passes (checks, host requests) cover every element
+  launch(step_stress_, cl::NDRange(items, 2), local);
 }
 
 void Simulator::enqueue_check() const {

@@ -257,6 +257,7 @@ class Simulator {
   std::vector<double> contact_area_host_;
   int check_slots_ = 0;  ///< hyperelastic: tissue ids, law table, Q and F rows
   cl::Kernel stress_;
+  cl::Kernel step_stress_;  ///< stress_pair_: element_stress with the step's arguments (enqueue_stress_pair)
   cl::Program program_;
   std::vector<std::string> kernel_files_;
   std::string build_options_;

@@ -255,11 +255,11 @@ std::vector<double> heun_steps_with(const Scene& s, const char* env, const std::
   const auto u0 = field(m.lattice, [](const Vec3& X) {
     return Vec3(0.0002 * std::sin(300 * X.z()), 0.0001 * std::cos(400 * X.x()), -0.0002 * std::sin(250 * X.y()));
   });
-  auto sim_with = [&] {
+  std::unique_ptr<Simulator> made;
+  {
     const test::ScopedEnv set(env, value);
-    return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
-  };
-  const std::unique_ptr<Simulator> made = sim_with();
+    made = std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
+  }
   Simulator& sim = *made;
   check(sim);
   sim.upload(u0, std::vector<double>(u0.size(), 0.0));
