@@ -130,3 +130,16 @@ inline void pending_v(real4* vj, real4 wg, VB_PENDING_PARAMS) {
 #define VB_IND_STRIDE 20
 #define VB_INDENTER_PARAMS global const real *indenters, real t_force, real t_project
 #define VB_INDENTER_ARGS indenters, t_force, t_project
+
+// The state arena (Simulator::state_, engine/sim/device_arena.hpp): u, v, ũ, ṽ, the rest frame,
+// the obstacle table and the volume constraint's gradient, partial sums and scalars in one buffer.
+// The kernels a step launches (the stepping kernels, element_stress, volume_partials,
+// volume_apply) take it as their last argument and each of those arrays as its offset (units of
+// VB_ARENA_UNIT bytes) where a buffer argument would be: one buffer argument instead of up to
+// six per launch (docs/PERF_NOTES.md, change 19). Other kernels take the arrays as buffers (the
+// host's sub-buffers); no kernel takes both the arena and a sub-buffer of it (OpenCL leaves
+// concurrent use of a buffer and its sub-buffers undefined).
+#define VB_STATE_PARAM , global uchar *state_arena
+#define VB_STATE_AT(type, slot) ((global type*)VB_ARENA_AT(state_arena, slot))
+#define VB_INDENTER_AT_PARAMS uint indenters_at, real t_force, real t_project
+#define VB_UNPACK_INDENTERS global const real* indenters = VB_STATE_AT(const real, indenters_at)

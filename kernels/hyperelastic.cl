@@ -390,15 +390,26 @@ inline void element_stress_one(uint e, global const real4* u, global uchar* aren
 // arena's slots pred_at (what heun_correct reads). One row is the stress of u alone (checks).
 // In the step, with list_n > 0, work-item i takes element list[i] of the arena's list at list_at:
 // only the elements some free element reads (Simulator, elements_read_by_free).
-kernel void element_stress(global const real4* u, global uchar* arena, uint8 at, int sy, int sz, real h, uint n,
-                           global const real4* rest_frame
+// u, the rest frame, the pending projection's gradient and scalars and v are state arena offsets
+// (kernels/common.cl, VB_STATE_PARAM).
+kernel void element_stress(uint u_at, global uchar* arena, uint8 at, int sy, int sz, real h, uint n,
+                           uint rest_frame_at
 #if VB_VOLUME_FOLD
-                           , global const real4* pend_g, global const real* pend_scalars
+                           , uint pend_g_at, uint pend_scalars_at
 #endif
 #if VB_STRESS_PAIR
-                           , global const real4* v, real dt, uint2 pred_at, uint list_at, uint list_n
+                           , uint v_at, real dt, uint2 pred_at, uint list_at, uint list_n
 #endif
-) {
+                           VB_STATE_PARAM) {
+  global const real4* u = VB_STATE_AT(const real4, u_at);
+  global const real4* rest_frame = VB_STATE_AT(const real4, rest_frame_at);
+#if VB_VOLUME_FOLD
+  global const real4* pend_g = VB_STATE_AT(const real4, pend_g_at);
+  global const real* pend_scalars = VB_STATE_AT(const real, pend_scalars_at);
+#endif
+#if VB_STRESS_PAIR
+  global const real4* v = VB_STATE_AT(const real4, v_at);
+#endif
   uint e = get_global_id(0);
 #if VB_STRESS_PAIR
   if (list_n) {

@@ -19,10 +19,11 @@
 #define VB_LAG_ARGS lag, lag_g, lag_p
 #define VB_NO_LAG 0, (global const real4*)0, (real)0
 VB_INLINE real4 less_lag(real4 f, uint e, VB_LAG_PARAMS) { return lag ? fma((real4)(-lag_p), lag_g[e], f) : f; }
-// heun_predict's own arguments: the gradient and the volume scalars {λ, μ, V, p, M}.
+// heun_predict's own arguments: the gradient and the volume scalars {λ, μ, V, p, M} (state arena
+// offsets).
 #if VB_VOLUME_LAG
-#define VB_LAG_KERNEL_PARAMS , global const real4 *lag_g, global const real *lag_scalars
-#define VB_LAG_KERNEL_ARGS 1, lag_g, lag_scalars[4] / dt
+#define VB_LAG_KERNEL_PARAMS , uint lag_g_at, uint lag_scalars_at
+#define VB_LAG_KERNEL_ARGS 1, VB_STATE_AT(const real4, lag_g_at), VB_STATE_AT(const real, lag_scalars_at)[4] / dt
 #else
 #define VB_LAG_KERNEL_PARAMS
 #define VB_LAG_KERNEL_ARGS VB_NO_LAG
@@ -156,10 +157,20 @@ VB_INLINE void explicit_stage(uint e, global const real4* u, global const real4*
   v_out[e] = vi;
 }
 
-kernel void euler_step(global const real4* u, global const real4* v, global real4* u_out,
-                       global real4* v_out, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
-                       uint n VB_TRI_PARAMS) {
+// The stepping kernels' entries take u, v and where the stage goes as state arena offsets
+// (kernels/common.cl, VB_STATE_PARAM).
+#define VB_UNPACK_STEP_STATE(in_const, out_const)                       \
+  VB_UNPACK_INDENTERS;                                                  \
+  in_const global real4* u = VB_STATE_AT(real4, u_at);                  \
+  in_const global real4* v = VB_STATE_AT(real4, v_at);                  \
+  out_const global real4* u_out = VB_STATE_AT(real4, u_out_at);         \
+  out_const global real4* v_out = VB_STATE_AT(real4, v_out_at)
+#define VB_STEP_STATE_PARAMS uint u_at, uint v_at, uint u_out_at, uint v_out_at
+
+kernel void euler_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
+                       uint n VB_TRI_PARAMS VB_STATE_PARAM) {
   VB_UNPACK_LATTICE;
+  VB_UNPACK_STEP_STATE(const, );
   explicit_stage(get_global_id(0), u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1, VB_NO_PENDING,
                  VB_NO_LAG VB_TRI_ARGS);
 }
@@ -169,8 +180,10 @@ kernel void euler_step(global const real4* u, global const real4* v, global real
 // when none is pending): heun_predict that of (u, v); heun_correct that of (u, v) for the element's
 // own u, v and that of the predicted stage (ũ, ṽ) for every read of it.
 #if VB_VOLUME_FOLD
-#define VB_FOLD_PARAMS(name) , global const real4 *name##_g, global const real *name##_scalars
-#define VB_FOLD_PENDING(name) name##_g, name##_scalars[0], name##_scalars[1], 1
+#define VB_FOLD_PARAMS(name) , uint name##_g_at, uint name##_scalars_at
+#define VB_FOLD_PENDING(name)                                                                          \
+  VB_STATE_AT(const real4, name##_g_at), VB_STATE_AT(const real, name##_scalars_at)[0],                \
+      VB_STATE_AT(const real, name##_scalars_at)[1], 1
 #else
 #define VB_FOLD_PARAMS(name)
 #define VB_FOLD_PENDING(name) VB_NO_PENDING
@@ -246,20 +259,23 @@ VB_INLINE void correct_element(uint e, global real4* u, global real4* v, global 
 #define VB_STEP_SHARE local real4* share = 0
 #endif
 
-kernel VB_STEP_ATTR void heun_predict(global const real4* u, global const real4* v, global real4* u_pred,
-                                      global real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
-                                      uint n VB_FOLD_PARAMS(state) VB_LAG_KERNEL_PARAMS VB_TRI_PARAMS) {
+kernel VB_STEP_ATTR void heun_predict(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
+                                      uint n VB_FOLD_PARAMS(state) VB_LAG_KERNEL_PARAMS VB_TRI_PARAMS
+                                          VB_STATE_PARAM) {
   VB_UNPACK_LATTICE;
+  VB_UNPACK_STEP_STATE(const, );
   VB_STEP_SHARE;
-  predict_element(VB_STEP_ELEMENT, u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n,
+  predict_element(VB_STEP_ELEMENT, u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n,
                   VB_FOLD_PENDING(state), VB_LAG_KERNEL_ARGS, share VB_TRI_ARGS);
 }
 
-kernel VB_STEP_ATTR void heun_correct(global real4* u, global real4* v, global const real4* u_pred,
-                                      global const real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS,
-                                      real dt, uint n VB_FOLD_PARAMS(state) VB_FOLD_PARAMS(pred) VB_TRI_PARAMS) {
+// heun_correct reads the predicted stage from u_out_at, v_out_at and writes u, v.
+kernel VB_STEP_ATTR void heun_correct(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
+                                      uint n VB_FOLD_PARAMS(state) VB_FOLD_PARAMS(pred) VB_TRI_PARAMS
+                                          VB_STATE_PARAM) {
   VB_UNPACK_LATTICE;
+  VB_UNPACK_STEP_STATE(, const);
   VB_STEP_SHARE;
-  correct_element(VB_STEP_ELEMENT, u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n,
+  correct_element(VB_STEP_ELEMENT, u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n,
                   VB_FOLD_PENDING(state), VB_FOLD_PENDING(pred), share VB_TRI_ARGS);
 }

@@ -150,30 +150,33 @@ VB_INLINE void lane_explicit_stage(global const real4* u4, global const real4* v
   lane_store((global real*)v_out, e, vn, relax ? 0 : vw, one);
 }
 
-kernel void heun_predict_lanes(global const real4* u, global const real4* v, global real4* u_pred,
-                               global real4* v_pred, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
-                               uint n_free, int one, global const uint* free_list VB_LAG_KERNEL_PARAMS) {
-  lane_explicit_stage(u, v, u_pred, v_pred, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 0, 0, 0, 0,
+// The entries take the state as offsets into the state arena, as integrate.cl's (no obstacles
+// here: indenters_at is unused).
+kernel void heun_predict_lanes(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
+                               uint n_free, int one, global const uint* free_list VB_LAG_KERNEL_PARAMS VB_STATE_PARAM) {
+  lane_explicit_stage(VB_STATE_AT(const real4, u_at), VB_STATE_AT(const real4, v_at), VB_STATE_AT(real4, u_out_at),
+                      VB_STATE_AT(real4, v_out_at), VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 0, 0, 0, 0,
                       VB_LAG_KERNEL_ARGS);
 }
 
-kernel void euler_step_lanes(global const real4* u, global const real4* v, global real4* u_out, global real4* v_out,
-                             VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt, uint n_free, int one,
-                             global const uint* free_list) {
-  lane_explicit_stage(u, v, u_out, v_out, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 0, 0, 0, VB_NO_LAG);
+kernel void euler_step_lanes(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
+                             uint n_free, int one, global const uint* free_list VB_STATE_PARAM) {
+  lane_explicit_stage(VB_STATE_AT(const real4, u_at), VB_STATE_AT(const real4, v_at), VB_STATE_AT(real4, u_out_at),
+                      VB_STATE_AT(real4, v_out_at), VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 0, 0, 0, VB_NO_LAG);
 }
 
 // Heun's corrector: u' = u + dt/2·(v + ṽ), v' = (v + ṽ)/2 + dt/2·a(ũ, ṽ), forces from the predicted
 // stage.
-kernel void heun_correct_lanes(global real4* u4, global real4* v4, global const real4* u_pred4,
-                               global const real4* v_pred4, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
-                               uint n_free, int one, global const uint* free_list) {
+kernel void heun_correct_lanes(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
+                               uint n_free, int one, global const uint* free_list VB_STATE_PARAM) {
   VB_UNPACK_LATTICE;
   const uint k = get_global_id(0);
   if (k >= n_free) return;
   const uint e = free_list[k];
-  global const real* up_all = (global const real*)u_pred4;
-  global const real* vp_all = (global const real*)v_pred4;
+  global real4* u4 = VB_STATE_AT(real4, u_at);
+  global real4* v4 = VB_STATE_AT(real4, v_at);
+  global const real* up_all = VB_STATE_AT(const real, u_out_at);  // the predicted stage
+  global const real* vp_all = VB_STATE_AT(const real, v_out_at);
   global const real* u = (global const real*)u4;
   global const real* v = (global const real*)v4;
   const real wi = lane_w(u, e, one);

@@ -6,10 +6,10 @@
 // next to stiff skin no longer waits for the step the skin sets. c is the host's estimate of
 // critical damping of the lowest mode (the Rayleigh quotient the check kernel sums), updated at
 // each check. Gravity still uses the real mass (u.w), so the equilibrium is the real one.
-kernel void relax_step(global const real4* u, global const real4* v, global real4* u_out,
-                       global real4* v_out, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
-                       uint n, global const real* relax_scale, real c VB_TRI_PARAMS) {
+kernel void relax_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
+                       uint n, global const real* relax_scale, real c VB_TRI_PARAMS VB_STATE_PARAM) {
   VB_UNPACK_LATTICE;
+  VB_UNPACK_STEP_STATE(const, );
   const uint e = get_global_id(0);
   if (e >= n) return;
   real4 ui = u[e], vi = v[e];
@@ -35,11 +35,11 @@ kernel void relax_step(global const real4* u, global const real4* v, global real
 #if VB_LANES
 // relax_step on scalar components, for CPUs, over the free elements (kernels/integrate_lanes.cl:
 // why, which scenes, and free_list): the same operations in the same order.
-kernel void relax_step_lanes(global const real4* u, global const real4* v, global real4* u_out,
-                             global real4* v_out, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_PARAMS, real dt,
+kernel void relax_step_lanes(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
                              uint n_free, global const real* relax_scale, real c, int one,
-                             global const uint* free_list) {
-  lane_explicit_stage(u, v, u_out, v_out, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 1, relax_scale, c,
+                             global const uint* free_list VB_STATE_PARAM) {
+  lane_explicit_stage(VB_STATE_AT(const real4, u_at), VB_STATE_AT(const real4, v_at), VB_STATE_AT(real4, u_out_at),
+                      VB_STATE_AT(real4, v_out_at), VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 1, relax_scale, c,
                       VB_NO_LAG);
 }
 #endif

@@ -68,7 +68,11 @@ inline void volume_item_values(uint i, global const real4* u, global const real4
     // four (corner, triangle, cell, u). Unrolled, the chains of several triangles overlap on a GPU
     // (the sum keeps its order; both forms give the same value).
     real4 g = 0;
+    // (PoCL declines the unroll with a warning since these pointers come from the state arena;
+    // CPUs overlap the chains without it.)
+#if VB_NV_PTX
 #pragma unroll 4
+#endif
     for (uint k = incident_start[i]; k < incident_start[i + 1]; ++k) {
 #if VB_VOLUME_PAIRS
       const uint2 bc = incident[k];
@@ -124,11 +128,16 @@ inline void volume_group_partials(uint group, global const real4* u, global cons
   barrier(CLK_LOCAL_MEM_FENCE);  // s is free again for the group's next call
 }
 
+// u, v, the gradient and the partial sums are state arena offsets (kernels/common.cl, VB_STATE_PARAM).
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
-void volume_partials(global const real4* u, global const real4* v, VB_LATTICE_KERNEL_PARAMS, VB_VOLUME_MESH_KERNEL_PARAMS,
-                     global real4* grad, int with_force, global real* partial) {
+void volume_partials(uint u_at, uint v_at, VB_LATTICE_KERNEL_PARAMS, VB_VOLUME_MESH_KERNEL_PARAMS, uint grad_at,
+                     int with_force, uint partial_at VB_STATE_PARAM) {
   VB_UNPACK_LATTICE;
   VB_UNPACK_MESH;
+  global const real4* u = VB_STATE_AT(const real4, u_at);
+  global const real4* v = VB_STATE_AT(const real4, v_at);
+  global real4* grad = VB_STATE_AT(real4, grad_at);
+  global real* partial = VB_STATE_AT(real, partial_at);
   local real s[VB_VOLUME_SLOTS * VB_CHECK_WG];
   volume_group_partials(get_group_id(0), u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, with_force, partial, s);
 }
@@ -175,11 +184,16 @@ inline void volume_apply_one(uint e, global real4* u, global real4* v, real4 g, 
   v[e] = v[e] - out[1] * wg;
 }
 
+// u, v, the gradient, the partial sums and the scalars are state arena offsets.
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
-void volume_apply(global real4* u, global real4* v, global const uchar* mesh, uint4 mesh_at, uint n_surface,
-                  global const real4* grad, global const real* partial, uint groups, real rest_volume,
-                  global real* scalars) {
+void volume_apply(uint u_at, uint v_at, global const uchar* mesh, uint4 mesh_at, uint n_surface, uint grad_at,
+                  uint partial_at, uint groups, real rest_volume, uint scalars_at VB_STATE_PARAM) {
   VB_UNPACK_SURFACE;
+  global real4* u = VB_STATE_AT(real4, u_at);
+  global real4* v = VB_STATE_AT(real4, v_at);
+  global const real4* grad = VB_STATE_AT(const real4, grad_at);
+  global const real* partial = VB_STATE_AT(const real, partial_at);
+  global real* scalars = VB_STATE_AT(real, scalars_at);
   local real s[VB_VOLUME_SLOTS * VB_CHECK_WG];
   const uint i = get_global_id(0), l = get_local_id(0);
   real out[4];

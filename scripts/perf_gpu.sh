@@ -33,20 +33,39 @@ ref=""
 if [[ -f .device-pkgs/ref.tar.xz ]]; then
   ref=$(mktemp -d) && tar -C "$ref" -xJf .device-pkgs/ref.tar.xz && ref=$ref/bin/voxbreast
 fi
+bench=(bench --device gpu --quick --no-study --profile)
+# name, binary, then bench arguments; the environment of the call applies
+# (all rows into one file: the device tool brings back few files)
+row() {
+  local name=$1 bin=$2; shift 2
+  echo "== $name: $bin $*" | tee -a "$out/rows.txt"
+  run "$bin" "${bench[@]}" "$@" --out "$(mktemp -d)" 2>&1 | tee -a "$out/rows.txt"
+}
+gpu_tests() {
+  VOXBREAST_DEVICE=gpu run test_physics --gtest_filter='*VolumeKernels*:VolumeConstraint.*:*KernelForces*:*KernelSteps*:HyperelasticKernels.*:*Uniaxial*:*SimpleShear*:*Tension*:*PlateCompression*:*BiphasicKernels*:*RestOffsets*:*TorusContact*:*Relaxation*:PersistentStep.*:LanesStep.*' \
+    2>&1 | grep -E '^\[ *(OK|FAILED|PASSED) *\]|Failure|pending vs' | tee "$out/gpu_tests.txt"
+}
 
-VOXBREAST_DEVICE=gpu run test_physics --gtest_filter='*VolumeKernels*:VolumeConstraint.*:*KernelForces*:*KernelSteps*:HyperelasticKernels.*:*Uniaxial*:*SimpleShear*:*Tension*:*PlateCompression*:*BiphasicKernels*:*RestOffsets*:*TorusContact*:*Relaxation*:PersistentStep.*' \
-  2>&1 | grep -E '^\[ *(OK|FAILED|PASSED) *\]|Failure|pending vs' | tee "$out/gpu_tests.txt"
+# `perf_gpu.sh target` (~5 min): only the 36k target rows (two-term Ogden + volume; --breast runs
+# the breast phantom and the cube), three rounds interleaved with the reference build's, then the
+# GPU tests.
+if [[ "${1:-}" == target ]]; then
+  for round in 1 2 3; do
+    row "new_r$round" voxbreast --breast --sizes 33 --laws ogden --volume
+    [[ -n "$ref" ]] && row "ref_r$round" "$ref" --breast --sizes 33 --laws ogden --volume
+  done
+  # the projection in one launch (volume_project) instead of two
+  VOXBREAST_VOLUME_LAUNCHES=1 row breast_project1 voxbreast --breast --sizes 33 --laws ogden --volume
+  gpu_tests
+  grep -hE '^== |^(block|breast)(_volume)? +[0-9]+ elements|device alone|error' "$out/rows.txt" | tee "$out/summary.txt"
+  exit
+fi
+
+gpu_tests
 # the split force passes (four work-items per element, any law) against the host
 VOXBREAST_DEVICE=gpu VOXBREAST_FORCE_SPLIT=4 run test_physics --gtest_filter='*KernelSteps*:HyperelasticKernels.MatchHost*' \
   2>&1 | grep -E '^\[ *(OK|FAILED|PASSED) *\]|Failure' | tee "$out/gpu_tests_split4.txt"
 
-bench=(bench --device gpu --quick --no-study --profile)
-# name, binary, then bench arguments; the environment of the call applies
-row() {
-  local name=$1 bin=$2; shift 2
-  echo "== $name: $bin $*" | tee "$out/$name.txt"
-  run "$bin" "${bench[@]}" "$@" --out "$out/$name" 2>&1 | tee -a "$out/$name.txt"
-}
 for round in 1 2; do
   row "36k_r$round" voxbreast --sizes 33 --laws linear ogden --volume
   # one launch per pass instead of the persistent step (kernels/persistent.cl)
@@ -63,8 +82,9 @@ VOXBREAST_FORCE_SPLIT=1 row 36k_split1 voxbreast --sizes 33 --laws ogden --volum
 VOXBREAST_FORCE_SPLIT=4 row 36k_split4 voxbreast --sizes 33 --laws ogden --volume
 row 1.5M voxbreast --sizes 115 --laws ogden
 [[ -n "$ref" ]] && row 1.5M_ref "$ref" --sizes 115 --laws ogden
-grep -hE '^== |^(block|breast)(_volume)? +[0-9]+ elements' "$out"/*.txt | tee "$out/summary.txt"
-# PTX and build logs (registers, spills) of the 36k Ogden + volume program
-VOXBREAST_DUMP_KERNELS="$out/ptx" VOXBREAST_CL_OPTIONS=-cl-nv-verbose \
-  run voxbreast bench --device gpu --quick --no-study --sizes 8 --laws ogden --volume --out "$out/ptx_run" >/dev/null 2>&1
-tar -C "$out/.." -czf "$out/../perf.tar.gz" perf
+grep -hE '^== |^(block|breast)(_volume)? +[0-9]+ elements' "$out/rows.txt" | tee "$out/summary.txt"
+# PTX and build logs (registers, spills) of the 36k Ogden + volume program, as one archive
+ptx=$(mktemp -d)
+VOXBREAST_DUMP_KERNELS="$ptx/ptx" VOXBREAST_CL_OPTIONS=-cl-nv-verbose \
+  run voxbreast bench --device gpu --quick --no-study --sizes 8 --laws ogden --volume --out "$ptx/run" >/dev/null 2>&1
+tar -C "$ptx" -czf "$out/ptx.tar.gz" ptx

@@ -34,4 +34,10 @@ void DeviceArena::create(const ClContext& cl) {
   staging_ = {};
 }
 
+cl_uint DeviceArena::offset_units_of(const cl::Buffer& part) const {
+  for (std::size_t i = 0; i < parts_.size(); ++i)
+    if (parts_[i]() == part()) return offset_units(i);
+  throw Error("device arena: the buffer is not one of its arrays");
+}
+
 }  // namespace vb

@@ -29,6 +29,8 @@ class DeviceArena {
   const cl::Buffer& part(std::size_t i) const { return parts_.at(i); }
   /// Offset of array i in units of kUnit bytes (what kernels take).
   cl_uint offset_units(std::size_t i) const { return cl_uint(offsets_.at(i) / kUnit); }
+  /// The same for the array whose sub-buffer is `part` (throws if it is none of them).
+  cl_uint offset_units_of(const cl::Buffer& part) const;
   std::size_t bytes() const { return total_bytes_; }
 
  private:

@@ -72,6 +72,17 @@ std::string mib(double bytes) { return std::to_string(static_cast<long long>(byt
 
 namespace {
 
+/// The elements of a surface mesh's vertices, each once in order of first appearance, and each
+/// element's place in that list (index_of; kNoSurface off the surface).
+constexpr std::uint32_t kNoSurface = 0xffffffffu;
+std::vector<cl_uint> mesh_surface_elements(const SurfaceMesh& mesh, std::size_t n, std::vector<std::uint32_t>& index_of) {
+  index_of.assign(n, kNoSurface);
+  std::vector<cl_uint> surface;
+  for (const std::uint32_t e : mesh.element_of_vertex)
+    if (index_of[e] == kNoSurface) index_of[e] = std::uint32_t(surface.size()), surface.push_back(e);
+  return surface;
+}
+
 /// The elements whose element stress some free element reads in a step: the free ones (their own
 /// Q) and every neighbour of one (Q·h·d and the hourglass term's C). A held element deep in the
 /// held region is read by nobody.
@@ -194,10 +205,13 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   const std::size_t frame_bytes = (rest_offsets_ && hyper_ ? 3 * n_ : 1) * 4 * real_size_;
   if (rest_offsets_) device_bytes_ += offset_bytes + (hyper_ ? frame_bytes : 0);
   make_model_arena(el, grid, cell_of, offset_bytes);
-  for (cl::Buffer* b : {&u_, &v_, &u_tmp_, &v_tmp_}) *b = cl::Buffer(cl.context, CL_MEM_READ_WRITE, state_bytes);
+  for (const IndenterSpec& ind : scene.indenters) {  // before the obstacle table (state arena)
+    motion_.push_back({ind.start_m, ind.velocity_m_s, 0.0, ind.travel_time_s});
+    if (!ind.path.empty()) motion_.back() = {ind.path.front().position_m, Vec3::Zero(), 0.0, 0.0};
+  }
+  path_segment_.assign(scene.indenters.size(), std::size_t(-1));
+  make_state_arena(state_bytes, frame_bytes);
   upload(el.displacement_m, std::vector<double>(3 * n_, 0.0));
-  std::vector<char> blank(frame_bytes, 0);
-  rest_frame_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, frame_bytes, blank.data());
 
   const std::size_t wg = kCheckWorkGroup;
   check_groups_ = (n_ + wg - 1) / wg;
@@ -220,12 +234,6 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
               std::to_string(local_bytes) + " bytes)",
           "indenter, device.torus", "use fewer indenters or tori, or float precision");
   partial_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * check_slots_ * real_size_);
-  for (const IndenterSpec& ind : scene.indenters) {
-    motion_.push_back({ind.start_m, ind.velocity_m_s, 0.0, ind.travel_time_s});
-    if (!ind.path.empty()) motion_.back() = {ind.path.front().position_m, Vec3::Zero(), 0.0, 0.0};
-  }
-  path_segment_.assign(scene.indenters.size(), std::size_t(-1));
-  indenters_ = make_real_buffer(obstacle_table());
   partial_arg_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE, check_groups_ * sizeof(cl_int));
 
   // Only the features this scene uses are compiled in.
@@ -305,11 +313,12 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     const auto stress_kernel = [&](cl_uint list_n) {
       cl::Kernel k(program_, "element_stress");
       set_element_fit_args(k);
-      k.setArg(0, u_);
+      k.setArg(0, at(u_));
       k.setArg(6, cl_uint(n_));
-      k.setArg(7, rest_frame_);
+      k.setArg(7, at(rest_frame_));
+      set_state_arena_arg(k);
       if (stress_pair_) {
-        k.setArg(8, v_);
+        k.setArg(8, at(v_));
         set_real(k, 9, dt_.dt_s);
         k.setArg(10, cl_uint2{{arena_at_pred_.s[5], arena_at_pred_.s[6]}});
         k.setArg(11, stress_list_at_);
@@ -336,14 +345,16 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_}) {
     if (!(*k)()) continue;
     set_lattice_args(*k, kStepLattice);
-    set_indenter_args(*k, kStepIndenter, 0.0, 0.0);
+    k->setArg(kStepIndenter, at(indenters_));
+    set_indenter_times(*k, kStepIndenter, 0.0, 0.0);
+    set_state_arena_arg(*k);
     set_real(*k, kStepIndenter + kIndenterArgs, dt_.dt_s);
     k->setArg(kStepIndenter + kIndenterArgs + 1, cl_uint(n_));
   }
   if (lanes_) make_lane_args();
   if (heun) {
-    predict_.setArg(0, u_); predict_.setArg(1, v_); predict_.setArg(2, u_tmp_); predict_.setArg(3, v_tmp_);
-    correct_.setArg(0, u_); correct_.setArg(1, v_); correct_.setArg(2, u_tmp_); correct_.setArg(3, v_tmp_);
+    set_step_state_args(predict_, u_, v_, u_tmp_, v_tmp_);
+    set_step_state_args(correct_, u_, v_, u_tmp_, v_tmp_);  // reads the stage from u_tmp_, v_tmp_
     correct_.setArg(kStepLattice + 1, arena_at_pred_);  // the predicted stage's stress (arena_at_ without the pair)
   }
   set_lattice_args(check_, kCheckLattice);
@@ -489,14 +500,35 @@ void Simulator::make_contact_area_buffer() {
   check_.setArg(kCheckVolume + (volume_ ? 2 : 0), contact_area_);
 }
 
+void Simulator::make_state_arena(std::size_t state_bytes, std::size_t frame_bytes) {
+  // Everything the step's kernels read or write besides the model arena (kernels/common.cl,
+  // VB_STATE_PARAM), zeros to start with but the obstacle table.
+  const std::vector<unsigned char> table = real_bytes(obstacle_table());
+  std::vector<std::pair<cl::Buffer*, std::size_t>> parts = {
+      {&u_, state_bytes}, {&v_, state_bytes}, {&u_tmp_, state_bytes}, {&v_tmp_, state_bytes},
+      {&rest_frame_, frame_bytes}, {&indenters_, table.size()}};
+  if (volume_) {
+    std::vector<std::uint32_t> index_of;
+    const std::size_t groups = (mesh_surface_elements(surface_, n_, index_of).size() + kCheckWorkGroup - 1) / kCheckWorkGroup;
+    const std::size_t grad = 4 * real_size_ * n_, scalars = kVolumeScalars * real_size_;
+    parts.insert(parts.end(), {{&vol_grad_, grad}, {&vol_partial_, groups * kVolumeSlots * real_size_}, {&vol_scalars_, scalars}});
+    if (volume_launches_ == 0)  // the predicted stage's pending projection, and no projection
+      parts.insert(parts.end(), {{&vol_grad_pred_, grad}, {&vol_scalars_pred_, scalars}, {&vol_no_scalars_, scalars}});
+  }
+  for (const auto& [buffer, bytes] : parts) state_.add(buffer == &indenters_ ? table.data() : nullptr, bytes);
+  require(state_.bytes() <= cl_.info.max_allocation_bytes,
+          "the model's state needs one buffer of " + mib(double(state_.bytes())) + " but '" + cl_.info.name +
+              "' allocates at most " + mib(double(cl_.info.max_allocation_bytes)),
+          "model", "downsample or crop the model");
+  state_.create(cl_);
+  for (std::size_t i = 0; i < parts.size(); ++i) *parts[i].first = state_.part(i);
+}
+
 void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   // Triangles as element ids; per surface element the corners (3·triangle + corner) it is in,
   // over all its vertices (an element on a pinch has several).
-  constexpr std::uint32_t kNone = 0xffffffffu;
-  std::vector<std::uint32_t> surface_index(n_, kNone);
-  std::vector<cl_uint> surface;
-  for (const std::uint32_t e : mesh.element_of_vertex)
-    if (surface_index[e] == kNone) surface_index[e] = std::uint32_t(surface.size()), surface.push_back(e);
+  std::vector<std::uint32_t> surface_index;
+  const std::vector<cl_uint> surface = mesh_surface_elements(mesh, n_, surface_index);
   std::vector<cl_uint> triangles(3 * mesh.triangles.size()), start(surface.size() + 1, 0), incident;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
     for (int c = 0; c < 3; ++c) {
@@ -534,16 +566,14 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   vol_mesh_.add(incident.data(), incident.size() * sizeof(cl_uint));
   vol_mesh_.create(cl_);
   for (int i = 0; i < 4; ++i) vol_mesh_at_.s[i] = vol_mesh_.offset_units(std::size_t(i));
-  std::vector<char> zeros(4 * real_size_ * n_, 0);  // gradient: zero off the surface
-  vol_grad_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, zeros.size(), zeros.data());
-  vol_partial_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE, volume_groups_ * kVolumeSlots * real_size_);
+  // the gradient (zero off the surface), partial sums and scalars are in the state arena
+  require(volume_groups_ * kVolumeSlots * real_size_ <= vol_partial_.getInfo<CL_MEM_SIZE>(),
+          "internal: the volume partial sums outgrew their buffer");
   const cl_uint zero = 0;  // volume_project's count of finished work-groups
   vol_done_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof zero, const_cast<cl_uint*>(&zero));
-  std::vector<char> scalar_zeros(kVolumeScalars * real_size_, 0);
-  vol_scalars_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, scalar_zeros.size(),
-                            scalar_zeros.data());
 
   // volume_partials and volume_project take the same lattice, mesh, centre and gradient arguments
+  // (volume_partials the gradient as a state arena offset)
   const auto mesh_kernel = [&](const char* name) {
     cl::Kernel k(program_, name);
     set_lattice_args(k, 2);
@@ -551,11 +581,13 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
     k.setArg(kVolumeMesh + 1, vol_mesh_at_);
     k.setArg(kVolumeMesh + 2, cl_uint(volume_surface_));
     set_world_vector(k, kVolumeCentre, centre);
-    k.setArg(kVolumeCentre + 1, vol_grad_);
+    if (std::strcmp(name, "volume_partials") == 0) k.setArg(kVolumeCentre + 1, at(vol_grad_));
+    else k.setArg(kVolumeCentre + 1, vol_grad_);
     return k;
   };
   vol_partials_ = mesh_kernel("volume_partials");
-  vol_partials_.setArg(kVolumeWithForce + 1, vol_partial_);
+  vol_partials_.setArg(kVolumeWithForce + 1, at(vol_partial_));
+  set_state_arena_arg(vol_partials_);
   vol_finish_ = cl::Kernel(program_, "volume_finish");
   vol_finish_.setArg(0, vol_partial_);
   vol_finish_.setArg(1, cl_uint(volume_groups_));
@@ -564,10 +596,11 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   vol_apply_.setArg(2, vol_mesh_.buffer());
   vol_apply_.setArg(3, vol_mesh_at_);
   vol_apply_.setArg(4, cl_uint(volume_surface_));
-  vol_apply_.setArg(5, vol_grad_);
-  vol_apply_.setArg(6, vol_partial_);
+  vol_apply_.setArg(5, at(vol_grad_));
+  vol_apply_.setArg(6, at(vol_partial_));
   vol_apply_.setArg(7, cl_uint(volume_groups_));
-  vol_apply_.setArg(kApplyRestVolume + 1, vol_scalars_);
+  vol_apply_.setArg(kApplyRestVolume + 1, at(vol_scalars_));
+  set_state_arena_arg(vol_apply_);
   vol_project_ = mesh_kernel("volume_project");
   vol_project_.setArg(kProjectGrad + 1, vol_partial_);
   vol_project_.setArg(kProjectRestVolume + 1, vol_scalars_);
@@ -575,21 +608,17 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   if (volume_launches_ == 0) {
     // the predicted stage's projection has its own gradient and scalars: the state's stays
     // pending for heun_correct's own u, v while the stage's is computed
-    vol_grad_pred_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, zeros.size(), zeros.data());
-    vol_scalars_pred_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, scalar_zeros.size(),
-                                   scalar_zeros.data());
-    vol_no_scalars_ = cl::Buffer(cl_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, scalar_zeros.size(),
-                                 scalar_zeros.data());
+    // (its gradient and scalars, and zero scalars, are in the state arena)
     device_bytes_ += 4 * real_size_ * n_;
     vol_pending_ = mesh_kernel("volume_pending");
     vol_pending_.setArg(kProjectGrad + 1, vol_partial_);
     vol_pending_.setArg(kProjectRestVolume + 2, vol_done_);
     set_fold_args(false, false);
   }
-  if (volume_lag_) {  // heun_predict's (and heun_predict_lanes') last arguments before VB_TRI_PARAMS
-    const int last = int(predict_.getInfo<CL_KERNEL_NUM_ARGS>()) - (tri_contact_ ? kTriangleArgs : 0);
-    predict_.setArg(last - 2, vol_grad_);
-    predict_.setArg(last - 1, vol_scalars_);
+  if (volume_lag_) {  // heun_predict's (and heun_predict_lanes') last arguments before VB_TRI_PARAMS, the arena
+    const int last = int(predict_.getInfo<CL_KERNEL_NUM_ARGS>()) - (tri_contact_ ? kTriangleArgs : 0) - 1;
+    predict_.setArg(last - 2, at(vol_grad_));
+    predict_.setArg(last - 1, at(vol_scalars_));
   }
   set_rest_volume_args();
   check_.setArg(kCheckVolume, vol_grad_);
@@ -608,14 +637,15 @@ void Simulator::set_rest_volume_args() {
 void Simulator::set_fold_args(bool state_pending, bool pred_pending) {
   // kernels/integrate.cl (VB_FOLD_PARAMS): after dt, n the state's gradient and scalars, then
   // (heun_correct) the predicted stage's; zero scalars where nothing is pending
-  const cl::Buffer& state = state_pending ? vol_scalars_ : vol_no_scalars_;
-  const cl::Buffer& pred = pred_pending ? vol_scalars_pred_ : vol_no_scalars_;
+  // (state arena offsets)
+  const cl_uint state = at(state_pending ? vol_scalars_ : vol_no_scalars_);
+  const cl_uint pred = at(pred_pending ? vol_scalars_pred_ : vol_no_scalars_);
   const int a = kStepIndenter + kIndenterArgs + 2;
   for (cl::Kernel* k : {&predict_, &correct_}) {
-    k->setArg(a, vol_grad_);
+    k->setArg(a, at(vol_grad_));
     k->setArg(a + 1, state);
   }
-  correct_.setArg(a + 2, vol_grad_pred_);
+  correct_.setArg(a + 2, at(vol_grad_pred_));
   correct_.setArg(a + 3, pred);
 }
 
@@ -631,8 +661,8 @@ void Simulator::apply_pending_projection() const {
   if (!pending_) return;
   // volume_apply sums the partials the last volume_pending left (the same λ, μ) and applies them
   pending_ = false;
-  vol_apply_.setArg(0, u_);
-  vol_apply_.setArg(1, v_);
+  vol_apply_.setArg(0, at(u_));
+  vol_apply_.setArg(1, at(v_));
   const std::size_t wg = kCheckWorkGroup, global = (volume_surface_ + wg - 1) / wg * wg;
   launch(vol_apply_, cl::NDRange(global), cl::NDRange(wg));
 }
@@ -640,8 +670,8 @@ void Simulator::apply_pending_projection() const {
 void Simulator::enqueue_volume_sums(bool with_force) { enqueue_volume_sums(with_force, u_, v_); }
 
 void Simulator::enqueue_volume_partials(bool with_force, const cl::Buffer& u, const cl::Buffer& v) {
-  vol_partials_.setArg(0, u);
-  vol_partials_.setArg(1, v);
+  vol_partials_.setArg(0, at(u));
+  vol_partials_.setArg(1, at(v));
   vol_partials_.setArg(kVolumeWithForce, cl_int(with_force));
   launch(vol_partials_, cl::NDRange(volume_groups_ * kCheckWorkGroup), cl::NDRange(kCheckWorkGroup));
 }
@@ -660,8 +690,8 @@ void Simulator::enqueue_volume_correction(const cl::Buffer& u, const cl::Buffer&
     return;
   }
   enqueue_volume_partials(false, u, v);  // volume_apply sums the partials itself: no volume_finish
-  vol_apply_.setArg(0, u);
-  vol_apply_.setArg(1, v);
+  vol_apply_.setArg(0, at(u));
+  vol_apply_.setArg(1, at(v));
   const std::size_t wg = kCheckWorkGroup, global = (volume_surface_ + wg - 1) / wg * wg;
   launch(vol_apply_, cl::NDRange(global), cl::NDRange(wg));
 }
@@ -900,8 +930,24 @@ std::vector<double> Simulator::obstacle_table() const {
 
 void Simulator::set_indenter_args(cl::Kernel& k, int a, double t_force, double t_project) {
   k.setArg(a, indenters_);
+  set_indenter_times(k, a, t_force, t_project);
+}
+
+void Simulator::set_indenter_times(cl::Kernel& k, int a, double t_force, double t_project) {
   set_real(k, a + 1, t_force);
   set_real(k, a + 2, t_project);
+}
+
+void Simulator::set_state_arena_arg(cl::Kernel& k) const {
+  k.setArg(k.getInfo<CL_KERNEL_NUM_ARGS>() - 1, state_.buffer());
+}
+
+void Simulator::set_step_state_args(cl::Kernel& k, const cl::Buffer& u, const cl::Buffer& v, const cl::Buffer& u_out,
+                                    const cl::Buffer& v_out) const {
+  k.setArg(0, at(u));
+  k.setArg(1, at(v));
+  k.setArg(2, at(u_out));
+  k.setArg(3, at(v_out));
 }
 
 void Simulator::launch(cl::Kernel& k, const cl::NDRange& global, const cl::NDRange& local) const {
@@ -929,10 +975,10 @@ void Simulator::enqueue(cl::Kernel& k) const { launch(k, global_, local_); }
 
 void Simulator::enqueue_stress(const cl::Buffer& u, const cl::Buffer* pending_grad, const cl::Buffer* pending_scalars) {
   if (!hyper_) return;
-  stress_.setArg(0, u);
+  stress_.setArg(0, at(u));
   if (volume_launches_ == 0) {  // element_stress's pending projection (VB_VOLUME_FOLD)
-    stress_.setArg(8, pending_grad ? *pending_grad : vol_grad_);
-    stress_.setArg(9, pending_scalars ? *pending_scalars : vol_no_scalars_);
+    stress_.setArg(8, at(pending_grad ? *pending_grad : vol_grad_));
+    stress_.setArg(9, at(pending_scalars ? *pending_scalars : vol_no_scalars_));
   }
   enqueue(stress_);
 }
@@ -966,8 +1012,8 @@ void Simulator::advance(std::int64_t steps) {
         continue;
       }
       if (indenter) {
-        set_indenter_args(predict_, kStepIndenter, t0, t1);
-        set_indenter_args(correct_, kStepIndenter, t1, t1);
+        set_indenter_times(predict_, kStepIndenter, t0, t1);
+        set_indenter_times(correct_, kStepIndenter, t1, t1);
       }
       if (volume_launches_ == 0) {
         // Projections left pending (kernels/volume.cl, volume_pending): the readers of each
@@ -995,8 +1041,8 @@ void Simulator::advance(std::int64_t steps) {
       launch(correct_, step_global_, step_local_);
     } else {
       cl::Kernel& k = relax_ ? relax_kernel_ : euler_;
-      k.setArg(0, u_); k.setArg(1, v_); k.setArg(2, u_tmp_); k.setArg(3, v_tmp_);
-      if (indenter) set_indenter_args(k, kStepIndenter, t0, t1);
+      set_step_state_args(k, u_, v_, u_tmp_, v_tmp_);
+      if (indenter) set_indenter_times(k, kStepIndenter, t0, t1);
       enqueue_stress(u_);
       enqueue_triangle_contact(u_, t0);
       launch(k, step_global_, step_local_);
@@ -1210,7 +1256,8 @@ void Simulator::make_triangle_contact_buffers() {
   tri_kernel_.setArg(11, corner_force_);
   for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_, &check_}) {
     if (!(*k)()) continue;
-    const int first = int(k->getInfo<CL_KERNEL_NUM_ARGS>()) - kTriangleArgs;  // VB_TRI_PARAMS
+    // VB_TRI_PARAMS, last but for the stepping kernels' state arena
+    const int first = int(k->getInfo<CL_KERNEL_NUM_ARGS>()) - kTriangleArgs - (k == &check_ ? 0 : 1);
     k->setArg(first + 0, corner_force_);
     k->setArg(first + 1, tri_start_);
     k->setArg(first + 2, tri_corner_);

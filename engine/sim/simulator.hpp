@@ -183,6 +183,8 @@ class Simulator {
 
  private:
   void set_indenter_args(cl::Kernel& k, int first_arg, double t_force, double t_project);
+  /// the stage times alone (the table argument set once)
+  void set_indenter_times(cl::Kernel& k, int first_arg, double t_force, double t_project);
   /// one indenter's row of the obstacle table (lattice frame, kernels/common.cl)
   std::vector<double> indenter_row(std::size_t i) const;
   /// recorded trajectories: switches each indenter's row to the segment holding time t
@@ -238,6 +240,18 @@ class Simulator {
   cl::NDRange global_, local_;
   std::size_t check_groups_ = 0;
 
+  /// u_, v_, u_tmp_, v_tmp_, rest_frame_, indenters_ and the volume constraint's buffers are
+  /// sub-buffers of one arena (kernels/common.cl, VB_STATE_PARAM): the step's kernels take the
+  /// arena and offsets, every other use the sub-buffers.
+  DeviceArena state_;
+  void make_state_arena(std::size_t state_bytes, std::size_t frame_bytes);
+  /// the state arena offset of one of its sub-buffers (what the step's kernels take)
+  cl_uint at(const cl::Buffer& part) const { return state_.offset_units_of(part); }
+  /// the state arena as a step kernel's last argument
+  void set_state_arena_arg(cl::Kernel& k) const;
+  /// the stepping kernels' first four arguments: where they read u, v and write the stage
+  void set_step_state_args(cl::Kernel& k, const cl::Buffer& u, const cl::Buffer& v, const cl::Buffer& u_out,
+                           const cl::Buffer& v_out) const;
   cl::Buffer u_, v_, u_tmp_, v_tmp_, partial_, partial_arg_;
   /// E, cell_of, grid, tissue ids, material table, Q, C, rest offsets (kernels/common.cl,
   /// VB_UNPACK_LATTICE) and their offsets; E_, cell_, rest_offset_ are the host's views of three.
