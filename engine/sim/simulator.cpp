@@ -30,7 +30,7 @@ constexpr int kTorusStride = 12;                                   // VB_TORUS_S
 // Kernel argument layout (kernels/common.cl): VB_LATTICE_KERNEL_PARAMS (the arena, its offsets,
 // then the scalars; gravity 7th) then VB_INDENTER_PARAMS.
 constexpr int kLatticeArgs = 10, kLatticeGravity = 6, kIndenterArgs = 3;
-constexpr int kStepLattice = 4;                              // step kernels: 4 state buffers first
+constexpr int kStepLattice = 4;  // step kernels: the 4 state arrays' offsets first (the state arena last)
 constexpr int kStepIndenter = kStepLattice + kLatticeArgs;   // then dt, n
 constexpr int kCheckLattice = 2;                             // check_state: u, v first
 constexpr int kCheckIndenter = kCheckLattice + kLatticeArgs; // then partial, partial_arg, n
@@ -44,7 +44,8 @@ constexpr int kVolumeMesh = 2 + kLatticeArgs;  // mesh arena, its offsets, n_sur
 constexpr int kVolumeCentre = kVolumeMesh + 3, kVolumeWithForce = kVolumeMesh + 5;
 // volume_project: u, v, the lattice parameters, the mesh, centre, then grad, partial, V0, scalars, count
 constexpr int kProjectGrad = kVolumeCentre + 1, kProjectRestVolume = kVolumeCentre + 3;
-// volume_apply: u, v, mesh arena, its offsets, n_surface, grad, partial, groups, V0, scalars
+// volume_apply: u, v, mesh arena, its offsets, n_surface, grad, partial, groups, V0, scalars (the
+// state arrays as state arena offsets, the arena last; volume_partials likewise)
 constexpr int kApplyRestVolume = 8;
 
 template <typename T>
@@ -573,19 +574,19 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   vol_done_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof zero, const_cast<cl_uint*>(&zero));
 
   // volume_partials and volume_project take the same lattice, mesh, centre and gradient arguments
-  // (volume_partials the gradient as a state arena offset)
-  const auto mesh_kernel = [&](const char* name) {
+  // (volume_partials, a step kernel, the gradient as a state arena offset)
+  const auto mesh_kernel = [&](const char* name, bool state_offsets) {
     cl::Kernel k(program_, name);
     set_lattice_args(k, 2);
     k.setArg(kVolumeMesh + 0, vol_mesh_.buffer());
     k.setArg(kVolumeMesh + 1, vol_mesh_at_);
     k.setArg(kVolumeMesh + 2, cl_uint(volume_surface_));
     set_world_vector(k, kVolumeCentre, centre);
-    if (std::strcmp(name, "volume_partials") == 0) k.setArg(kVolumeCentre + 1, at(vol_grad_));
+    if (state_offsets) k.setArg(kVolumeCentre + 1, at(vol_grad_));
     else k.setArg(kVolumeCentre + 1, vol_grad_);
     return k;
   };
-  vol_partials_ = mesh_kernel("volume_partials");
+  vol_partials_ = mesh_kernel("volume_partials", true);
   vol_partials_.setArg(kVolumeWithForce + 1, at(vol_partial_));
   set_state_arena_arg(vol_partials_);
   vol_finish_ = cl::Kernel(program_, "volume_finish");
@@ -601,7 +602,7 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   vol_apply_.setArg(7, cl_uint(volume_groups_));
   vol_apply_.setArg(kApplyRestVolume + 1, at(vol_scalars_));
   set_state_arena_arg(vol_apply_);
-  vol_project_ = mesh_kernel("volume_project");
+  vol_project_ = mesh_kernel("volume_project", false);
   vol_project_.setArg(kProjectGrad + 1, vol_partial_);
   vol_project_.setArg(kProjectRestVolume + 1, vol_scalars_);
   vol_project_.setArg(kProjectRestVolume + 2, vol_done_);
@@ -610,7 +611,7 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
     // pending for heun_correct's own u, v while the stage's is computed
     // (its gradient and scalars, and zero scalars, are in the state arena)
     device_bytes_ += 4 * real_size_ * n_;
-    vol_pending_ = mesh_kernel("volume_pending");
+    vol_pending_ = mesh_kernel("volume_pending", false);
     vol_pending_.setArg(kProjectGrad + 1, vol_partial_);
     vol_pending_.setArg(kProjectRestVolume + 2, vol_done_);
     set_fold_args(false, false);

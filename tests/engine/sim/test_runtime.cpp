@@ -111,6 +111,26 @@ TEST(OpenCLRuntime, ModelTooLargeForDeviceIsRefused) {
   }
 }
 
+// The state (u, v, the predicted stage, …) is one buffer (Simulator::state_): a device whose
+// largest allocation is below it refuses the model by name, even with memory to spare.
+TEST(OpenCLRuntime, StateLargerThanTheLargestAllocationIsRefused) {
+  Scene s = test::box_scene(20, 20, 20, 0.002);
+  s.solver.dashpot_ratio = 0.1;
+  const auto m = test::make_model(s);
+  const std::size_t state_bytes = 16 * m.lattice.element_count();  // one float4 per element
+  DeviceInfo info = test::cl_context().info;
+  info.max_allocation_bytes = 2 * state_bytes;  // room for any one array, not for u, v, ũ, ṽ together
+  const ClContext small(info);
+  try {
+    Simulator sim(s, m.lattice, m.elements, small);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("state needs one buffer"), std::string::npos) << e.what();
+  }
+  info.max_allocation_bytes = 8 * state_bytes;
+  EXPECT_NO_THROW(Simulator(s, m.lattice, m.elements, ClContext(info)));
+}
+
 TEST(OpenCLRuntime, DeviceMemoryEstimateScalesWithPrecisionAndLaw) {
   EXPECT_EQ(estimated_device_bytes(1000, 0, Precision::Float), 1000u * 72);
   EXPECT_EQ(estimated_device_bytes(1000, 10, Precision::Double), 1000u * 140 + 40);
