@@ -166,6 +166,10 @@ VB_INLINE void explicit_stage(uint e, global const real4* u, global const real4*
   out_const global real4* u_out = VB_STATE_AT(real4, u_out_at);         \
   out_const global real4* v_out = VB_STATE_AT(real4, v_out_at)
 #define VB_STEP_STATE_PARAMS uint u_at, uint v_at, uint u_out_at, uint v_out_at
+// The same four arrays as pointer arguments of a helper (the lanes kernels').
+#define VB_STEP_STATE_POINTERS                                                                  \
+  VB_STATE_AT(const real4, u_at), VB_STATE_AT(const real4, v_at), VB_STATE_AT(real4, u_out_at), \
+      VB_STATE_AT(real4, v_out_at)
 
 kernel void euler_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
                        uint n VB_TRI_PARAMS VB_STATE_PARAM) {

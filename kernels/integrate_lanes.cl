@@ -154,15 +154,13 @@ VB_INLINE void lane_explicit_stage(global const real4* u4, global const real4* v
 // here: indenters_at is unused).
 kernel void heun_predict_lanes(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
                                uint n_free, int one, global const uint* free_list VB_LAG_KERNEL_PARAMS VB_STATE_PARAM) {
-  lane_explicit_stage(VB_STATE_AT(const real4, u_at), VB_STATE_AT(const real4, v_at), VB_STATE_AT(real4, u_out_at),
-                      VB_STATE_AT(real4, v_out_at), VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 0, 0, 0, 0,
+  lane_explicit_stage(VB_STEP_STATE_POINTERS, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 0, 0, 0, 0,
                       VB_LAG_KERNEL_ARGS);
 }
 
 kernel void euler_step_lanes(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
                              uint n_free, int one, global const uint* free_list VB_STATE_PARAM) {
-  lane_explicit_stage(VB_STATE_AT(const real4, u_at), VB_STATE_AT(const real4, v_at), VB_STATE_AT(real4, u_out_at),
-                      VB_STATE_AT(real4, v_out_at), VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 0, 0, 0, VB_NO_LAG);
+  lane_explicit_stage(VB_STEP_STATE_POINTERS, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 0, 0, 0, VB_NO_LAG);
 }
 
 // Heun's corrector: u' = u + dt/2·(v + ṽ), v' = (v + ṽ)/2 + dt/2·a(ũ, ṽ), forces from the predicted

@@ -38,8 +38,7 @@ kernel void relax_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENT
 kernel void relax_step_lanes(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
                              uint n_free, global const real* relax_scale, real c, int one,
                              global const uint* free_list VB_STATE_PARAM) {
-  lane_explicit_stage(VB_STATE_AT(const real4, u_at), VB_STATE_AT(const real4, v_at), VB_STATE_AT(real4, u_out_at),
-                      VB_STATE_AT(real4, v_out_at), VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 1, relax_scale, c,
+  lane_explicit_stage(VB_STEP_STATE_POINTERS, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 1, relax_scale, c,
                       VB_NO_LAG);
 }
 #endif

@@ -46,7 +46,7 @@ gpu_tests() {
     2>&1 | grep -E '^\[ *(OK|FAILED|PASSED) *\]|Failure|pending vs' | tee "$out/gpu_tests.txt"
 }
 
-# `perf_gpu.sh target` (~5 min): only the 36k target rows (two-term Ogden + volume; --breast runs
+# `perf_gpu.sh target` (~7 min on an H200): only the 36k target rows (two-term Ogden + volume; --breast runs
 # the breast phantom and the cube), three rounds interleaved with the reference build's, then the
 # GPU tests.
 if [[ "${1:-}" == target ]]; then

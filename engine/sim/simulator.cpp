@@ -211,6 +211,13 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     if (!ind.path.empty()) motion_.back() = {ind.path.front().position_m, Vec3::Zero(), 0.0, 0.0};
   }
   path_segment_.assign(scene.indenters.size(), std::size_t(-1));
+  // the volume constraint's surface elements, one work-item each (kernels/volume.cl: the volume
+  // from Euler's theorem); the state arena sizes the partial sums by them
+  std::vector<std::uint32_t> surface_index;
+  const std::vector<cl_uint> surface_list =
+      volume_ ? mesh_surface_elements(surface_, n_, surface_index) : std::vector<cl_uint>{};
+  volume_surface_ = surface_list.size();
+  volume_groups_ = (volume_surface_ + kCheckWorkGroup - 1) / kCheckWorkGroup;
   make_state_arena(state_bytes, frame_bytes);
   upload(el.displacement_m, std::vector<double>(3 * n_, 0.0));
 
@@ -376,7 +383,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     const int last = int(check_.getInfo<CL_KERNEL_NUM_ARGS>());
     set_real(check_, last - 1 - (tri_contact_ ? kTriangleArgs : 0), dt_.dt_s);
   }
-  if (volume_) make_volume_buffers(surface_);
+  if (volume_) make_volume_buffers(surface_, surface_list, surface_index);
   if (!scene.tori.empty()) make_contact_area_buffer();
   if (tri_contact_) make_triangle_contact_buffers();
   if (persistent_.on) make_persistent_kernel();
@@ -509,10 +516,9 @@ void Simulator::make_state_arena(std::size_t state_bytes, std::size_t frame_byte
       {&u_, state_bytes}, {&v_, state_bytes}, {&u_tmp_, state_bytes}, {&v_tmp_, state_bytes},
       {&rest_frame_, frame_bytes}, {&indenters_, table.size()}};
   if (volume_) {
-    std::vector<std::uint32_t> index_of;
-    const std::size_t groups = (mesh_surface_elements(surface_, n_, index_of).size() + kCheckWorkGroup - 1) / kCheckWorkGroup;
     const std::size_t grad = 4 * real_size_ * n_, scalars = kVolumeScalars * real_size_;
-    parts.insert(parts.end(), {{&vol_grad_, grad}, {&vol_partial_, groups * kVolumeSlots * real_size_}, {&vol_scalars_, scalars}});
+    parts.insert(parts.end(),
+                 {{&vol_grad_, grad}, {&vol_partial_, volume_groups_ * kVolumeSlots * real_size_}, {&vol_scalars_, scalars}});
     if (volume_launches_ == 0)  // the predicted stage's pending projection, and no projection
       parts.insert(parts.end(), {{&vol_grad_pred_, grad}, {&vol_scalars_pred_, scalars}, {&vol_no_scalars_, scalars}});
   }
@@ -525,11 +531,10 @@ void Simulator::make_state_arena(std::size_t state_bytes, std::size_t frame_byte
   for (std::size_t i = 0; i < parts.size(); ++i) *parts[i].first = state_.part(i);
 }
 
-void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
+void Simulator::make_volume_buffers(const SurfaceMesh& mesh, const std::vector<cl_uint>& surface,
+                                    const std::vector<std::uint32_t>& surface_index) {
   // Triangles as element ids; per surface element the corners (3·triangle + corner) it is in,
   // over all its vertices (an element on a pinch has several).
-  std::vector<std::uint32_t> surface_index;
-  const std::vector<cl_uint> surface = mesh_surface_elements(mesh, n_, surface_index);
   std::vector<cl_uint> triangles(3 * mesh.triangles.size()), start(surface.size() + 1, 0), incident;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
     for (int c = 0; c < 3; ++c) {
@@ -550,9 +555,6 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
     incident = std::move(pairs);
   }
 
-  volume_surface_ = surface.size();
-  // one work-item per surface element (kernels/volume.cl: the volume from Euler's theorem)
-  volume_groups_ = (volume_surface_ + kCheckWorkGroup - 1) / kCheckWorkGroup;
   frame_sign_ = lattice_.rotation.determinant() < 0 ? -1.0 : 1.0;
   rest_volume_m3_ = double(mesh.complete_cell_count) * std::pow(lattice_.spacing_m, 3);
   Vec3 centre = Vec3::Zero();  // positions are taken relative to it, to keep rounding small
@@ -567,9 +569,7 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh) {
   vol_mesh_.add(incident.data(), incident.size() * sizeof(cl_uint));
   vol_mesh_.create(cl_);
   for (int i = 0; i < 4; ++i) vol_mesh_at_.s[i] = vol_mesh_.offset_units(std::size_t(i));
-  // the gradient (zero off the surface), partial sums and scalars are in the state arena
-  require(volume_groups_ * kVolumeSlots * real_size_ <= vol_partial_.getInfo<CL_MEM_SIZE>(),
-          "internal: the volume partial sums outgrew their buffer");
+  // (the gradient, zero off the surface, the partial sums and the scalars are in the state arena)
   const cl_uint zero = 0;  // volume_project's count of finished work-groups
   vol_done_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof zero, const_cast<cl_uint*>(&zero));
 

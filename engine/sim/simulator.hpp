@@ -289,7 +289,9 @@ class Simulator {
   mutable std::vector<std::pair<std::string, cl::Event>> events_;  ///< profiling queues only
 
   // Volume constraint ([volume] preserve): the surface mesh, uploaded once.
-  void make_volume_buffers(const SurfaceMesh& mesh);
+  /// surface, surface_index: the mesh's surface elements and each element's place among them
+  void make_volume_buffers(const SurfaceMesh& mesh, const std::vector<cl_uint>& surface,
+                           const std::vector<std::uint32_t>& surface_index);
   /// enqueues the partial sums (with the residual pressure when with_force) and λ, μ, V, p
   void enqueue_volume_sums(bool with_force);
   void enqueue_volume_sums(bool with_force, const cl::Buffer& u, const cl::Buffer& v);
