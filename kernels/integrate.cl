@@ -221,6 +221,8 @@ VB_INLINE void predict_element(uint e, global const real4* u, global const real4
 
 // Heun's corrector for element e (u', v' into u, v; the same calling rule as predict_element):
 // `pending` of the state (u, v) for the element's own u, v, and pred_* of the predicted stage.
+// The element's own u, v are read after the force loop, so they are not live across it (fewer
+// registers: PERF_NOTES.md change 20); the held test reads ũ.w, which the predictor copies from u.
 VB_INLINE void correct_element(uint e, global real4* u, global real4* v, global const real4* u_pred,
                                global const real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt, uint n,
                                VB_PENDING_PARAMS, global const real4* pred_g, real pred_lambda, real pred_mu,
@@ -229,27 +231,26 @@ VB_INLINE void correct_element(uint e, global real4* u, global real4* v, global 
 #if VB_SPLIT == 1
   if (!in) return;
 #endif
-  real4 ui = (real4)(0), vi = (real4)(0), up = (real4)(0), vp = (real4)(0), wg = (real4)(0), wgp = (real4)(0);
+  real4 up = (real4)(0), vp = (real4)(0), wgp = (real4)(0);
   if (in) {
-    ui = u[e];
-    vi = v[e];
     up = u_pred[e];
     vp = v_pred[e];
-    pending_u(&ui, &wg, e, VB_PENDING_ARGS);
-    pending_v(&vi, wg, VB_PENDING_ARGS);
     pending_u(&up, &wgp, e, pred_g, pred_lambda, pred_mu, pred_pending);
     pending_v(&vp, wgp, pred_g, pred_lambda, pred_mu, pred_pending);
   }
 #if VB_SPLIT > 1
-  const real4 f = split_lattice_force(in && ui.w != 0, e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, pred_g,
+  const real4 f = split_lattice_force(in && up.w != 0, e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, pred_g,
                                       pred_lambda, pred_mu, pred_pending, share);
   if (!in || get_local_id(0) >= VB_SPLIT_PER) return;
-  if (ui.w == 0) return;
+  if (up.w == 0) return;
 #else
-  if (ui.w == 0) return;
+  if (up.w == 0) return;
   const real4 f = lattice_force_pending(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, pred_g, pred_lambda, pred_mu,
                                         pred_pending, 0, 26);
 #endif
+  real4 ui = u[e], vi = v[e], wg = (real4)(0);
+  pending_u(&ui, &wg, e, VB_PENDING_ARGS);
+  pending_v(&vi, wg, VB_PENDING_ARGS);
   const real4 vn = correct_update(e, &ui, vi, up, vp, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt VB_TRI_ARGS);
   u[e] = ui;
   v[e] = vn;
