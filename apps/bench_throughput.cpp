@@ -74,6 +74,23 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+/// Enqueues `steps` steps in chunks, waiting for the chunk before the last before enqueueing the
+/// next, so that the queue never holds more than two chunks. A run issues at most check_every
+/// steps before it reads back; thousands of steps at once fill NVIDIA's queue, and the host
+/// blocked inside the driver then leaves gaps between launches (~20 µs per step at 1.5M elements:
+/// PERF_NOTES.md, session 17) that no run has.
+void advance_paced(Simulator& sim, std::int64_t steps) {
+  constexpr std::int64_t chunk = 32;
+  cl::Event before_last, last;
+  for (std::int64_t done = 0; done < steps; done += chunk) {
+    sim.advance(std::min(chunk, steps - done));
+    if (before_last()) before_last.wait();
+    before_last = last;
+    sim.context().queue.enqueueMarkerWithWaitList(nullptr, &last);
+    sim.context().queue.flush();
+  }
+}
+
 /// Steps per second, timed over enough steps to last about `target_s`.
 double time_steps(Simulator& sim, double target_s) {
   sim.advance(3);
@@ -81,7 +98,7 @@ double time_steps(Simulator& sim, double target_s) {
   std::int64_t steps = 4;
   for (;;) {
     const auto t0 = std::chrono::steady_clock::now();
-    sim.advance(steps);
+    advance_paced(sim, steps);
     sim.context().queue.finish();
     const double t = seconds_since(t0);
     if (t >= target_s || steps >= (1 << 22)) return double(steps) / t;
