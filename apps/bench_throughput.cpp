@@ -74,8 +74,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Enqueues `steps` steps in chunks, waiting for the chunk before the last before enqueueing the
-/// next, so that the queue never holds more than two chunks. A run issues at most check_every
+/// Enqueues `steps` steps in chunks of 32; after each chunk it waits for the one two chunks back,
+/// so that the queue never holds more than three chunks. A run issues at most check_every
 /// steps before it reads back; thousands of steps at once fill NVIDIA's queue, and the host
 /// blocked inside the driver then leaves gaps between launches (~20 µs per step at 1.5M elements:
 /// PERF_NOTES.md, session 17) that no run has.
