@@ -25,10 +25,20 @@ fi
 out=${OUT:?run on the device machine, where \$OUT is the folder that comes back}/bench
 mkdir -p "$out"
 bash scripts/gpu_run.sh run voxbreast info >"$out/device.txt" 2>&1 || true
+# SM clock and power every 250 ms: long float runs reach the card's power cap and clock down
+# (docs/PERF_NOTES.md, session 18), which the timed rates then include.
+smi=""
+if command -v nvidia-smi >/dev/null; then
+  nvidia-smi --query-gpu=timestamp,clocks.sm,power.draw,clocks_throttle_reasons.active --format=csv -lms 250 \
+    >"$out/clocks.csv" 2>&1 &
+  smi=$!
+fi
 # Full study (column, phantom, ~1.5M-element phantom) and the cube throughput series.
 # shellcheck disable=SC2086
 ${BENCH_TIMEOUT:+timeout $BENCH_TIMEOUT} bash scripts/gpu_run.sh run voxbreast bench --device gpu --out "$out" --phantom data-samples/phantom/scene.toml \
   --sizes 22 33 50 80 115 160 ${BENCH_ARGS:-} 2>&1 | tee "$out/bench.log" || echo "bench stopped early (see bench.log)"
-if command -v python3 >/dev/null; then python3 tests/apps/check_bench.py "$out" | tail -20; fi
+[[ -n "$smi" ]] && kill "$smi" 2>/dev/null || true
+# A failed sanity check is reported, and the archive is still packed.
+if command -v python3 >/dev/null; then python3 tests/apps/check_bench.py "$out" | tail -20 || true; fi
 # Few files come back from the device: one archive as well (unpack with tar -xzf bench.tar.gz).
 tar -C "$out/.." -czf "$out/../bench.tar.gz" bench
