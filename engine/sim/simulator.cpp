@@ -258,7 +258,8 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_CHECK_SLOTS=" + std::to_string(check_slots_);
   options += " -DVB_RSQRT=" + std::to_string(cl.info.is_gpu);
   // Denormal floats (< 1.2e-38: nothing in m, N, Pa) flushed to zero on GPUs: NVIDIA's rsqrt,
-  // rcp and sqrt then skip their denormal fix-up; 1.5M linear + Heun float 6% faster on the H200.
+  // rcp and sqrt then skip their denormal fix-up: the 1.5M linear Heun float step 3-4.5% shorter
+  // on the H200 (device time).
   // Not for the one-launch step, which it made 4% slower (36k linear), nor on CPUs, whose tests'
   // references keep IEEE denormals (docs/PERF_NOTES.md, change 21).
   if (cl.info.is_gpu && !persistent_.on) options += " -cl-denorms-are-zero";
