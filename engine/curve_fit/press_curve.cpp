@@ -19,7 +19,7 @@ std::vector<double> press_curve_forces(const Scene& scene_in, const Lattice& lat
   const Vec3 direction = ind.velocity_m_s.normalized();
   const double h = lattice.spacing_m, tol = scene.stop.equilibrium;
   require(tol > 0, "a force curve needs an equilibrium tolerance", "stop.equilibrium", "set it, e.g. 1e-7");
-  const double F_ref = equilibrium_scales(lattice, elements).first;
+  const double F_ref = equilibrium_scales(lattice, elements).force_n;
   const std::int64_t check_every = std::max(1, scene.solver.check_every);
   const std::int64_t max_steps = o.max_steps_per_level > 0 ? o.max_steps_per_level : scene.stop.max_steps;
 

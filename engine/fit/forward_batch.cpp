@@ -112,7 +112,7 @@ std::vector<ForwardSolution> ForwardModel::solve_batch(const std::vector<std::ve
     double F_ref = INFINITY;  // the strictest copy's tolerance
     for (std::size_t k = 0; k < K; ++k) {
       parts.push_back(arrays(moduli[first + k]));
-      F_ref = std::min(F_ref, equilibrium_scales(lat, parts.back()).first);
+      F_ref = std::min(F_ref, equilibrium_scales(lat, parts.back()).force_n);
     }
     const bool own_rows = parts.front().hyperelastic;  // per-copy μ, κ rows; springs read E per element
     const Lattice tiled = tile_lattice(lat, int(K), own_rows ? int(lat.tissue_names.size()) : 0);

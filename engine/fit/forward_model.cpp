@@ -130,7 +130,7 @@ ForwardSolution ForwardModel::solve_timed(const std::vector<double>& E, const Fo
   Simulator sim(scene_, lat, el, cl_);
   const std::size_t n = lat.element_count();
   const std::vector<double> zeros(3 * n, 0.0);
-  const double F_ref = equilibrium_scales(lat, el).first;
+  const double F_ref = equilibrium_scales(lat, el).force_n;
   lap(&JacobianTiming::setup_s);
   ForwardSolution out;
   out.from_m = zeros;

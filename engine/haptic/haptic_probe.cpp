@@ -26,8 +26,9 @@ HapticProbe::HapticProbe(const Scene& scene, const Lattice& lattice, const Eleme
   require(options.fold_check_move > 0 && options.fold_check_every_s > 0,
           "the fold monitor's move and interval must be positive", "fold_check_move, fold_check_every_s");
   spacing_m_ = lattice.spacing_m;
-  std::tie(F_ref_, wave_speed_) = equilibrium_scales(lattice, elements);
-  extent_m_ = spacing_m_ * Vec3(lattice.dims[0], lattice.dims[1], lattice.dims[2]).norm();
+  const EquilibriumScales scales = equilibrium_scales(lattice, elements);
+  F_ref_ = scales.force_n;
+  extent_m_ = scales.size_m;
   // Far above any contact stiffness of this probe (Hertz: 2E*·a with a ≤ R + h): a cap against
   // secant estimates gone wild, never a limit in a sane press.
   max_stiffness_n_m_ = 10 * (F_ref_ / (spacing_m_ * spacing_m_)) * (probe.radius_m + spacing_m_);

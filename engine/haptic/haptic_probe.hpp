@@ -96,7 +96,7 @@ class HapticProbe {
   const Lattice& lattice_;
   const ElementArrays& elements_;
   Simulator sim_;
-  double spacing_m_ = 0, F_ref_ = 0, wave_speed_ = 0, extent_m_ = 0, max_stiffness_n_m_ = 0;
+  double spacing_m_ = 0, F_ref_ = 0, extent_m_ = 0, max_stiffness_n_m_ = 0;
   std::int64_t steps_per_update_ = 1;
   Eigen::Matrix3d K_ = Eigen::Matrix3d::Zero();
   Vec3 secant_from_m_ = Vec3::Zero(), secant_force_n_ = Vec3::Zero();  ///< probe and force before its last move

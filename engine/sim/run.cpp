@@ -100,7 +100,7 @@ void record_tori(const Scene& scene, double t_s, const StateCheck& c, std::vecto
 
 }  // namespace
 
-std::pair<double, double> equilibrium_scales(const Lattice& lattice, const ElementArrays& el) {
+EquilibriumScales equilibrium_scales(const Lattice& lattice, const ElementArrays& el) {
   // Over the free elements: held tissue (rigid bone at 1 GPa, say) must not loosen the criterion.
   double E_max = 0, m_min = INFINITY;
   for (std::size_t e = 0; e < el.mass_kg.size(); ++e) {
@@ -109,7 +109,17 @@ std::pair<double, double> equilibrium_scales(const Lattice& lattice, const Eleme
     m_min = std::min(m_min, el.mass_kg[e]);
   }
   const double h = lattice.spacing_m;
-  return {E_max * h * h, std::sqrt(E_max / (m_min / (h * h * h)))};
+  return {E_max * h * h, std::sqrt(E_max / (m_min / (h * h * h))),
+          h * Eigen::Vector3d(lattice.dims[0], lattice.dims[1], lattice.dims[2]).norm()};
+}
+
+bool at_equilibrium(const Simulator& sim, const StateCheck& c, const EquilibriumScales& scales, double tol) {
+  if (c.max_residual_n > tol * scales.force_n) return false;
+  // A dynamic run's speed test bounds a like distance, tol·c / ω_min. The residual alone let
+  // relaxation stop 1% of the displacement from equilibrium on a soft column at 1e-5
+  // (docs/BENCHMARKS.md).
+  if (sim.relaxing()) return c.max_speed_m_s / std::sqrt(sim.relaxation_omega_sq()) <= tol * scales.size_m;
+  return c.max_speed_m_s <= tol * scales.wave_speed_m_s;
 }
 
 std::size_t nearest_element(const Lattice& lattice, const Vec3& p) {
@@ -125,9 +135,8 @@ std::size_t nearest_element(const Lattice& lattice, const Vec3& p) {
 RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const ElementArrays& el, Simulator& sim,
                          const std::function<void(const RunProgress&)>& progress) {
   const auto start = std::chrono::steady_clock::now();
-  const auto [F_ref, wave_speed] = equilibrium_scales(lattice, el);
-  const double h = lattice.spacing_m;
-  const double extent = h * Eigen::Vector3d(lattice.dims[0], lattice.dims[1], lattice.dims[2]).norm();
+  const EquilibriumScales scales = equilibrium_scales(lattice, el);
+  const double h = lattice.spacing_m, extent = scales.size_m;
   const double tol = scene.stop.equilibrium;
   double travel_end = 0;  // equilibrium only counts once every moving indenter has stopped
   for (const IndenterSpec& ind : scene.indenters) {
@@ -160,8 +169,8 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
     if (c.max_displacement_m > 10 * extent)
       report_instability(scene, lattice, el, sim, c, "displacement exceeds ten times the model size", " at ");
 
-    s.final_residual = c.max_residual_n / F_ref;
-    s.final_speed_ratio = c.max_speed_m_s / wave_speed;
+    s.final_residual = c.max_residual_n / scales.force_n;
+    s.final_speed_ratio = c.max_speed_m_s / scales.wave_speed_m_s;
     if (frames_every > 0 && sim.steps() % frames_every == 0) {
       std::vector<double> u, v;
       sim.download(u, v);
@@ -180,15 +189,7 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
     }
     record_tori(scene, sim.time_s(), c, s.tori);
     if (progress) progress({sim.steps(), max_steps, sim.time_s(), s.final_residual, s.final_speed_ratio});
-    // A relaxation's velocities are fictitious (scaled masses), so "at rest" is the distance still
-    // to go instead: its slowest mode decays as e^(−ω_min·t), leaving about max speed / ω_min
-    // (docs/PHYSICS.md, "Fast equilibrium"). Bounded by tol × the model's size; a dynamic run's
-    // speed test bounds a like distance, tol × wave speed / ω_min. The residual alone let
-    // relaxation stop 1% from equilibrium on a soft column at 1e-5 (docs/BENCHMARKS.md).
-    const bool at_rest = scene.solver.integrator == Integrator::Relaxation
-                             ? c.max_speed_m_s / std::sqrt(sim.relaxation_omega_sq()) <= tol * extent
-                             : s.final_speed_ratio <= tol;
-    const bool settled = tol > 0 && s.final_residual <= tol && at_rest && sim.time_s() >= travel_end;
+    const bool settled = tol > 0 && at_equilibrium(sim, c, scales, tol) && sim.time_s() >= travel_end;
     if (settled) {
       s.converged = true;
       s.stop_reason = "equilibrium";

@@ -26,9 +26,20 @@ struct RunOutput {
 RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const ElementArrays& elements,
                          Simulator& sim, const std::function<void(const RunProgress&)>& progress = {});
 
-/// Reference force F_ref = E_max·h² (N) and wave speed c = √(E_max/ρ_min) (m/s) of the
-/// equilibrium criterion (docs/SCENE.md).
-std::pair<double, double> equilibrium_scales(const Lattice& lattice, const ElementArrays& elements);
+/// The scales of the equilibrium criterion (docs/SCENE.md, "Equilibrium criterion").
+struct EquilibriumScales {
+  double force_n = 0;         ///< F_ref = E_max·h²
+  double wave_speed_m_s = 0;  ///< c = √(E_max/ρ_min)
+  double size_m = 0;          ///< L, the lattice's diagonal
+};
+EquilibriumScales equilibrium_scales(const Lattice& lattice, const ElementArrays& elements);
+
+/// Whether check c meets the equilibrium criterion at tolerance tol: the largest residual force
+/// ≤ tol·F_ref and, for the dynamic integrators, the largest speed ≤ tol·c; for relaxation, whose
+/// speeds are fictitious, the distance still to go, max speed / ω_min ≤ tol·L instead (its slowest
+/// mode decays as e^(−ω_min·t); docs/PHYSICS.md, "Fast equilibrium"). run_simulation stops on it;
+/// the probe presses, force curves and fit solves still stop relaxation on the residual alone.
+bool at_equilibrium(const Simulator& sim, const StateCheck& c, const EquilibriumScales& scales, double tol);
 
 /// Element nearest to a world point (m).
 std::size_t nearest_element(const Lattice& lattice, const Vec3& point_m);

@@ -120,6 +120,7 @@ class Simulator {
   /// Relaxation: the smallest Rayleigh quotient seen, an upper bound on ω_min² of the fictitious
   /// dynamics (1/s²; infinite before the first displacement).
   double relaxation_omega_sq() const { return relax_omega_sq_; }
+  bool relaxing() const { return relax_; }
   const TimeStepChoice& time_step() const { return dt_; }
   double time_s() const { return double(steps_) * dt_.dt_s; }
   std::int64_t steps() const { return steps_; }

@@ -85,7 +85,7 @@ TEST_P(RelaxationColumn, ReachesTheDampedEquilibriumInFewerSteps) {
 }
 
 // Stopped at tolerance 1e-5, relaxation must be about as close to equilibrium as the tolerance
-// says: its "at rest" test bounds the distance still to go by tol × the model's size (run.cpp).
+// says: at_equilibrium bounds its distance still to go by tol × the lattice's diagonal (run.hpp).
 // On the residual alone it stopped 20–29 × tol × size away here (0.4–1% of the displacement, as
 // on the GPU study's soft column, docs/BENCHMARKS.md); with the test, 0.95–1.04 ×.
 TEST_P(RelaxationColumn, StopsAsCloseToEquilibriumAsItsToleranceSays) {
@@ -97,8 +97,7 @@ TEST_P(RelaxationColumn, StopsAsCloseToEquilibriumAsItsToleranceSays) {
   const Settled stopped = settle(loose, m.lattice, m.elements);
   const Settled reference = settle(tight, m.lattice, m.elements);
   const double error = max_difference_m(stopped.u, reference.u);
-  const double extent = m.lattice.spacing_m * std::hypot(double(m.lattice.dims[0]), double(m.lattice.dims[1]),
-                                                        double(m.lattice.dims[2]));
+  const double extent = equilibrium_scales(m.lattice, m.elements).size_m;
   std::cout << GetParam() << ": tolerance 1e-5 after " << stopped.steps << " steps, " << error * 1e3
             << " mm from equilibrium (" << reference.steps << " steps), " << error / (1e-5 * extent)
             << " × tol × extent, " << error / reference.max_displacement_m * 100 << "% of the displacement\n";
