@@ -19,7 +19,8 @@ std::vector<double> press_curve_forces(const Scene& scene_in, const Lattice& lat
   const Vec3 direction = ind.velocity_m_s.normalized();
   const double h = lattice.spacing_m, tol = scene.stop.equilibrium;
   require(tol > 0, "a force curve needs an equilibrium tolerance", "stop.equilibrium", "set it, e.g. 1e-7");
-  const double F_ref = equilibrium_scales(lattice, elements).force_n;
+  const EquilibriumScales scales = equilibrium_scales(lattice, elements);
+  const double F_ref = scales.force_n;
   const std::int64_t check_every = std::max(1, scene.solver.check_every);
   const std::int64_t max_steps = o.max_steps_per_level > 0 ? o.max_steps_per_level : scene.stop.max_steps;
 
@@ -41,7 +42,7 @@ std::vector<double> press_curve_forces(const Scene& scene_in, const Lattice& lat
       require(c.nonfinite_elements == 0 && c.max_speed_m_s * sim.dt_s() <= 0.5 * h,
               "the press blew up at a travel of " + std::to_string(1e3 * d) + " mm", "solver",
               "use a smaller solver.dt, or check the material parameters");
-      if (sim.steps() - level_start >= ramp && c.max_residual_n <= tol * F_ref) {
+      if (sim.steps() - level_start >= ramp && at_equilibrium(sim, c, scales, tol)) {
         forces.push_back(-c.indenter_force_n[o.probe].dot(direction));
         break;
       }

@@ -109,10 +109,12 @@ std::vector<ForwardSolution> ForwardModel::solve_batch(const std::vector<std::ve
       continue;
     }
     std::vector<ElementArrays> parts;
-    double F_ref = INFINITY;  // the strictest copy's tolerance
+    EquilibriumScales scales{INFINITY, INFINITY, INFINITY};  // the strictest copy's, one copy's size
     for (std::size_t k = 0; k < K; ++k) {
       parts.push_back(arrays(moduli[first + k]));
-      F_ref = std::min(F_ref, equilibrium_scales(lat, parts.back()).force_n);
+      const EquilibriumScales s = equilibrium_scales(lat, parts.back());
+      scales = {std::min(scales.force_n, s.force_n), std::min(scales.wave_speed_m_s, s.wave_speed_m_s),
+                std::min(scales.size_m, s.size_m)};
     }
     const bool own_rows = parts.front().hyperelastic;  // per-copy μ, κ rows; springs read E per element
     const Lattice tiled = tile_lattice(lat, int(K), own_rows ? int(lat.tissue_names.size()) : 0);
@@ -128,7 +130,7 @@ std::vector<ForwardSolution> ForwardModel::solve_batch(const std::vector<std::ve
     if (fit_.from_gravity_m_s2) {
       if (warm) sim.upload(repeated(warm->from_m, K), zeros);
       lap(&JacobianTiming::upload_s);
-      steps += relax_to_equilibrium(sim, scene_, F_ref, *fit_.from_gravity_m_s2, "from");
+      steps += relax_to_equilibrium(sim, scene_, scales, *fit_.from_gravity_m_s2, "from");
       lap(&JacobianTiming::relax_s);
       sim.download(from, v);
       lap(&JacobianTiming::readback_s);
@@ -136,7 +138,7 @@ std::vector<ForwardSolution> ForwardModel::solve_batch(const std::vector<std::ve
     if (warm) sim.upload(repeated(warm->to_m, K), zeros);
     else if (fit_.from_gravity_m_s2) sim.upload(from, zeros);
     lap(&JacobianTiming::upload_s);
-    steps += relax_to_equilibrium(sim, scene_, F_ref, scene_.gravity.acceleration_m_s2, "to");
+    steps += relax_to_equilibrium(sim, scene_, scales, scene_.gravity.acceleration_m_s2, "to");
     lap(&JacobianTiming::relax_s);
     sim.download(to, v);
     lap(&JacobianTiming::readback_s);

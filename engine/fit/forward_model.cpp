@@ -130,7 +130,7 @@ ForwardSolution ForwardModel::solve_timed(const std::vector<double>& E, const Fo
   Simulator sim(scene_, lat, el, cl_);
   const std::size_t n = lat.element_count();
   const std::vector<double> zeros(3 * n, 0.0);
-  const double F_ref = equilibrium_scales(lat, el).force_n;
+  const EquilibriumScales scales = equilibrium_scales(lat, el);
   lap(&JacobianTiming::setup_s);
   ForwardSolution out;
   out.from_m = zeros;
@@ -138,7 +138,7 @@ ForwardSolution ForwardModel::solve_timed(const std::vector<double>& E, const Fo
   if (fit_.from_gravity_m_s2) {
     if (warm) sim.upload(warm->from_m, zeros);
     lap(&JacobianTiming::upload_s);
-    out.steps += relax_to_equilibrium(sim, scene_, F_ref, *fit_.from_gravity_m_s2, "from");
+    out.steps += relax_to_equilibrium(sim, scene_, scales, *fit_.from_gravity_m_s2, "from");
     lap(&JacobianTiming::relax_s);
     sim.download(out.from_m, v);
     lap(&JacobianTiming::readback_s);
@@ -146,7 +146,7 @@ ForwardSolution ForwardModel::solve_timed(const std::vector<double>& E, const Fo
   if (warm) sim.upload(warm->to_m, zeros);
   else if (fit_.from_gravity_m_s2) sim.upload(out.from_m, zeros);
   lap(&JacobianTiming::upload_s);
-  out.steps += relax_to_equilibrium(sim, scene_, F_ref, scene_.gravity.acceleration_m_s2, "to");
+  out.steps += relax_to_equilibrium(sim, scene_, scales, scene_.gravity.acceleration_m_s2, "to");
   lap(&JacobianTiming::relax_s);
   sim.download(out.to_m, v);
   lap(&JacobianTiming::readback_s);

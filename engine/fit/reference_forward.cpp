@@ -55,7 +55,7 @@ ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice&
   sim.set_rest_offsets(ref.rest_offset_m);
   const std::vector<double> still(3 * n, 0.0);
   sim.upload(warm ? warm->to_m : el.displacement_m, still);
-  out.steps += relax_to_equilibrium(sim, scene, equilibrium_scales(lattice, el).force_n,
+  out.steps += relax_to_equilibrium(sim, scene, equilibrium_scales(lattice, el),
                                     scene.gravity.acceleration_m_s2, "to");
   std::vector<double> v;
   sim.download(out.to_m, v);

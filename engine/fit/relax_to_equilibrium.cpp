@@ -8,7 +8,7 @@
 
 namespace vb {
 
-std::int64_t relax_to_equilibrium(Simulator& sim, const Scene& scene, double F_ref, const Vec3& g, const char* posture) {
+std::int64_t relax_to_equilibrium(Simulator& sim, const Scene& scene, const EquilibriumScales& scales, const Vec3& g, const char* posture) {
   sim.set_gravity(g);
   sim.restart_clock();
   const std::int64_t every = std::max(1, scene.solver.check_every);
@@ -18,10 +18,10 @@ std::int64_t relax_to_equilibrium(Simulator& sim, const Scene& scene, double F_r
     require(c.nonfinite_elements == 0 && std::isfinite(c.max_residual_n),
             "the forward solve went unstable (non-finite state)", std::string("fit, posture ") + posture,
             "a modulus bound may be too wide: set fit.min_E / fit.max_E");
-    if (c.max_residual_n <= scene.stop.equilibrium * F_ref) return sim.steps();
+    if (at_equilibrium(sim, c, scales, scene.stop.equilibrium)) return sim.steps();
     require(sim.steps() < scene.stop.max_steps,
             "the forward solve did not reach equilibrium in " + std::to_string(scene.stop.max_steps) +
-                " steps (residual " + std::to_string(c.max_residual_n / F_ref) + ")",
+                " steps (residual " + std::to_string(c.max_residual_n / scales.force_n) + ")",
             std::string("fit, posture ") + posture, "raise fit.max_steps or fit.equilibrium");
   }
 }

@@ -37,8 +37,8 @@ EquilibriumScales equilibrium_scales(const Lattice& lattice, const ElementArrays
 /// Whether check c meets the equilibrium criterion at tolerance tol: the largest residual force
 /// ≤ tol·F_ref and, for the dynamic integrators, the largest speed ≤ tol·c; for relaxation, whose
 /// speeds are fictitious, the distance still to go, max speed / ω_min ≤ tol·L instead (its slowest
-/// mode decays as e^(−ω_min·t); docs/PHYSICS.md, "Fast equilibrium"). run_simulation stops on it;
-/// the probe presses, force curves and fit solves still stop relaxation on the residual alone.
+/// mode decays as e^(−ω_min·t); docs/PHYSICS.md, "Fast equilibrium"). Runs, probe presses, force
+/// curves and fit solves stop on it.
 bool at_equilibrium(const Simulator& sim, const StateCheck& c, const EquilibriumScales& scales, double tol);
 
 /// Element nearest to a world point (m).

@@ -2,9 +2,10 @@
 // sweep on the GPU reported forces below the tumour-free baseline over a tumour's edge: the 16 mm
 // ball pressed 4 mm (two spacings) crushed the surface layer between itself and the stiff
 // tumour until the surface element under it was pushed through the element below (det F < 0).
-// The spring lattice has no resistance to inversion, so the folded state is softer: the last
-// increment's force rise halves and the ball sinks into the fold. This reproduces it on a small
-// block: 8 mm of soft tissue (500 Pa) over a stiff (10 kPa) inclusion, h = 2 mm.
+// The spring lattice has no resistance to inversion, so a collapsing layer is softer: the force's
+// rise per increment falls where contact theory (F ∝ d^1.5) and a stiff inclusion make it grow.
+// This reproduces it on a small block: 8 mm of soft tissue (500 Pa), with or without a stiff
+// (10 kPa) inclusion below, h = 2 mm.
 #include <gtest/gtest.h>
 
 #include "tests/engine/probe/probe_fixtures.hpp"
@@ -38,20 +39,37 @@ Scene block_over_inclusion(bool inclusion, double depth_m, int steps) {
   return s;
 }
 
-TEST(Probing, PressThatFoldsTheLatticeIsFlagged) {
-  const ProbeResult deep = test::run_probe(block_over_inclusion(true, 2 * kH, 4));
-  const PressResult& p = deep.presses.at(0);
+void print_press(const char* name, const PressResult& p) {
   for (const PressSample& s : p.samples)
-    std::printf("depth %.1f mm  F %.5g N  contact %lld  min det F %.3f  folded %lld\n", 1e3 * s.depth_m, s.press_force_n,
-                (long long)s.contact_elements, s.min_det_f, (long long)s.inverted_elements);
-  EXPECT_TRUE(p.inverted) << "the last increment folds the surface layer";
-  EXPECT_LE(p.min_det_f, 0);
-  EXPECT_GE(deep.inverted_increments, 1);
-  EXPECT_GT(p.samples.back().inverted_elements, 0);
-  // The symptom: the folded state is softer, the force's rise over the last increment drops.
-  const auto rise = [&](std::size_t j) { return p.samples[j].press_force_n - p.samples[j - 1].press_force_n; };
-  EXPECT_LT(rise(4), 0.75 * rise(3));
-  EXPECT_FALSE(p.samples[2].inverted_elements > 0) << "half as deep, nothing folds";
+    std::printf("%s: depth %.1f mm  F %.5g N  contact %lld  min det F %.3f  folded %lld\n", name, 1e3 * s.depth_m,
+                s.press_force_n, (long long)s.contact_elements, s.min_det_f, (long long)s.inverted_elements);
+}
+
+double rise(const PressResult& p, std::size_t j) { return p.samples[j].press_force_n - p.samples[j - 1].press_force_n; }
+
+TEST(Probing, PressThatFoldsTheLatticeIsFlagged) {
+  const ProbeResult over = test::run_probe(block_over_inclusion(true, 2 * kH, 4));
+  const ProbeResult plain = test::run_probe(block_over_inclusion(false, 2 * kH, 4));
+  const PressResult &a = over.presses.at(0), &b = plain.presses.at(0);
+  print_press("over the inclusion", a);
+  print_press("no inclusion", b);
+  for (const ProbeResult* r : {&over, &plain}) {
+    const PressResult& p = r->presses.at(0);
+    EXPECT_TRUE(p.inverted) << "the last increment folds the surface layer";
+    EXPECT_LE(p.min_det_f, 0);
+    EXPECT_GE(r->inverted_increments, 1);
+    EXPECT_GT(p.samples.back().inverted_elements, 0);
+    EXPECT_FALSE(p.samples[2].inverted_elements > 0) << "half as deep, nothing folds";
+  }
+  // Without the inclusion the layer stays whole to 3 mm and each increment's rise grows, then
+  // the folded increment's rise drops below three quarters of the one before.
+  EXPECT_GT(b.samples[3].min_det_f, 0.3);
+  EXPECT_GT(rise(b, 3), rise(b, 2));
+  EXPECT_LT(rise(b, 4), 0.75 * rise(b, 3));
+  // Over the stiff inclusion the layer is crushed an increment earlier: at 3 mm it is nearly
+  // flat (det F → 0) and that increment's rise already falls below the one before.
+  EXPECT_LT(a.samples[3].min_det_f, 0.25);
+  EXPECT_LT(rise(a, 3), rise(a, 2));
 }
 
 TEST(Probing, ShallowPressOverInclusionStaysValidAndStiffer) {
