@@ -131,7 +131,7 @@ VB_INLINE void lane_explicit_stage(global const real4* u4, global const real4* v
   const lane3 ui = lane_xyz(u, e, one), vi = lane_xyz(v, e, one);
   const real wi = lane_w(u, e, one), vw = lane_w(v, e, one);
   lane3 f = lane_lattice_force(e, ui, wi, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio, one);
-  if (lag) {  // Heun's predicted stage under the lagged constraint pressure: integrate.cl's less_lag
+  if (lag) {  // under the lagged constraint pressure (Heun's predicted stage, relaxation): integrate.cl's less_lag
     const lane3 g = lane_xyz((global const real*)lag_g, e, one);
     f.x = fma(-lag_p, g.x, f.x);
     f.y = fma(-lag_p, g.y, f.y);

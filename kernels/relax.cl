@@ -6,8 +6,15 @@
 // next to stiff skin no longer waits for the step the skin sets. c is the host's estimate of
 // critical damping of the lowest mode (the Rayleigh quotient the check kernel sums), updated at
 // each check. Gravity still uses the real mass (u.w), so the equilibrium is the real one.
+// With the volume constraint (VB_VOLUME_LAG) the step feels the constraint's lagged pressure, as
+// Heun's predicted stage does (kernels/integrate.cl, less_lag), and the projection after it only
+// corrects what that misses (kernels/volume.cl, lag_update: M ← M + μ, so at equilibrium M = dt·p).
+// With the projection alone the fixed point was no equilibrium of the constrained problem (each
+// step pushes the surface off the constraint by dt²·p·g/m̃, the projection moves it back by the
+// real masses, along the gradient where the step left it): the residual stalled at ~1e-3·F_ref
+// (test RelaxationColumn.WithTheVolumeConstraintReachesTheDampedEquilibrium).
 kernel void relax_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
-                       uint n, global const real* relax_scale, real c VB_TRI_PARAMS VB_STATE_PARAM) {
+                       uint n, global const real* relax_scale, real c VB_LAG_KERNEL_PARAMS VB_TRI_PARAMS VB_STATE_PARAM) {
   VB_UNPACK_LATTICE;
   VB_UNPACK_STEP_STATE(const, );
   const uint e = get_global_id(0);
@@ -17,7 +24,8 @@ kernel void relax_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENT
     // acceleration() is f/m with the indenters' constraint (no global damping is compiled in);
     // m/m̃ turns it into f/m̃, then the fictitious damping.
     torus_grip grip = {0};  // on the acceleration, as in integrate.cl (the indenters' scaled here)
-    real4 a = acceleration(e, ui, vi, u, v, VB_LATTICE_ARGS, indenters, t_force, &grip VB_TRI_ARGS) * relax_scale[e] -
+    const real4 f = less_lag(lattice_force(e, ui, vi, u, v, VB_LATTICE_ARGS), e, VB_LAG_KERNEL_ARGS);
+    real4 a = acceleration_from(f, e, ui, vi, VB_LATTICE_ARGS, indenters, t_force, &grip VB_TRI_ARGS) * relax_scale[e] -
               c * xyz0(vi);
     grip.grip_n *= relax_scale[e];
 #if VB_TORI
@@ -37,8 +45,8 @@ kernel void relax_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENT
 // why, which scenes, and free_list): the same operations in the same order.
 kernel void relax_step_lanes(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
                              uint n_free, global const real* relax_scale, real c, int one,
-                             global const uint* free_list VB_STATE_PARAM) {
+                             global const uint* free_list VB_LAG_KERNEL_PARAMS VB_STATE_PARAM) {
   lane_explicit_stage(VB_STEP_STATE_POINTERS, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 1, relax_scale, c,
-                      VB_NO_LAG);
+                      VB_LAG_KERNEL_ARGS);
 }
 #endif

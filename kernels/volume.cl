@@ -13,10 +13,11 @@
 //   and g = ∂V/∂x of every surface element into `grad` (indexed by element).
 //   volume_finish: one work-group; scalars = {λ, μ, V, p}: λ = (V0 − V)/Σw|g|², μ = Σg·v/Σw|g|²,
 //     p = Σg·f/Σ|g|² (the pressure the check subtracts from the residual).
-//   With VB_VOLUME_LAG (Heun; kernels/integrate.cl, less_lag) the corrections (volume_apply,
-//     volume_project) also update scalars[4], the multiplier M ← μ + M/2 whose pressure M/dt the
-//     next predicted stage feels: at a constrained equilibrium μ = dt·p − M/2, so M = dt·p is the
-//     fixed point, reached in one step once the motion is quasi-static.
+//   With VB_VOLUME_LAG (Heun and relaxation; kernels/integrate.cl, less_lag) the corrections
+//     (volume_apply, volume_project) also update scalars[4], the multiplier M whose pressure M/dt
+//     the next predicted stage (relaxation: the next step) feels; Heun M ← μ + M/2: at a
+//     constrained equilibrium μ = dt·p − M/2, so M = dt·p is the fixed point, reached in one step
+//     once the motion is quasi-static (relaxation: lag_update).
 //   volume_apply: x += λ·w·g, v −= μ·w·g on the free surface elements; each of its work-groups
 //     sums the partials itself (the same sums in the same order as volume_finish), so a
 //     projection is two launches (partials, apply), not three.
@@ -169,8 +170,12 @@ void volume_finish(global const real* partial, uint groups, real rest_volume, gl
 }
 
 // The lagged multiplier after a correction that removed μ (one work-item; nothing without VB_VOLUME_LAG).
+// Heun: M ← μ + M/2 (its corrector averages two stages, only the predicted one feels M);
+// relaxation: M ← M + μ (its one stage feels M; at equilibrium μ = dt·p − M, so M = dt·p).
 inline void lag_update(global real* scalars, real mu) {
-#if VB_VOLUME_LAG
+#if VB_VOLUME_LAG && VB_RELAX
+  scalars[4] = mu + scalars[4];
+#elif VB_VOLUME_LAG
   scalars[4] = mu + (real)0.5 * scalars[4];
 #endif
 }

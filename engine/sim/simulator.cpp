@@ -438,8 +438,9 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
   // Projected as before when the scene asks, between corrections (every > 1: no multiplier to
   // lag), with folded projections, and in the one-launch step (kernels/persistent.cl keeps its
   // own schedule).
-  volume_lag_ = volume_ && heun_steps && scene.volume.every == 1 &&
-                scene.volume.predictor == VolumeSpec::Predictor::Pressure && !folded && !persistent_.on;
+  // Relaxation's step feels the lagged pressure too (kernels/relax.cl: why).
+  const bool lag_heun = heun_steps && scene.volume.predictor == VolumeSpec::Predictor::Pressure;
+  volume_lag_ = volume_ && (lag_heun || relax_) && scene.volume.every == 1 && !folded && !persistent_.on;
   // Both of Heun's element stresses in one launch (kernels/hyperelastic.cl, VB_STRESS_PAIR): the
   // predicted stage moves each free element to ũ = u + dt·v whatever its force, so the stress at ũ
   // needs only (u, v). Not where something else moves ũ: indenters and tori project it out of
@@ -622,10 +623,11 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh, const std::vector<c
     vol_pending_.setArg(kProjectRestVolume + 2, vol_done_);
     set_fold_args(false, false);
   }
-  if (volume_lag_) {  // heun_predict's (and heun_predict_lanes') last arguments before VB_TRI_PARAMS, the arena
-    const int last = int(predict_.getInfo<CL_KERNEL_NUM_ARGS>()) - (tri_contact_ ? kTriangleArgs : 0) - 1;
-    predict_.setArg(last - 2, at(vol_grad_));
-    predict_.setArg(last - 1, at(vol_scalars_));
+  if (volume_lag_) {  // heun_predict's or relax_step's (and lanes') last arguments before VB_TRI_PARAMS, the arena
+    cl::Kernel& k = relax_ ? relax_kernel_ : predict_;
+    const int last = int(k.getInfo<CL_KERNEL_NUM_ARGS>()) - (tri_contact_ ? kTriangleArgs : 0) - 1;
+    k.setArg(last - 2, at(vol_grad_));
+    k.setArg(last - 1, at(vol_scalars_));
   }
   set_rest_volume_args();
   check_.setArg(kCheckVolume, vol_grad_);
