@@ -158,6 +158,13 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   if (relax_) device_bytes_ += n_ * 9 * real_size_;  // mass scale; u and lattice force at the last check
   volume_ = scene.volume.preserve;
   require(!volume_ || scene.volume.every >= 1, "volume.every must be at least 1", "volume.every");
+  // Relaxation reaches the constrained equilibrium only by the lagged pressure of a projection
+  // every step (kernels/relax.cl); between sparser projections the surface drifts and is pulled
+  // back, so it would never meet its stop (docs/PHYSICS.md, "Volume preservation").
+  require(!volume_ || !relax_ || scene.volume.every == 1,
+          "relaxation with the volume constraint needs a projection every step (volume.every = " +
+              std::to_string(scene.volume.every) + " would never reach equilibrium)",
+          "volume.every", "set every = 1, or use integrator = \"heun\"");
   if (volume_) {
     surface_ = build_surface(lattice);
     const SurfaceMesh& mesh = surface_;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <iostream>
 
+#include "engine/error.hpp"
 #include "engine/image/image_lattice.hpp"
 #include "engine/loads/posture.hpp"
 #include "engine/sim/run.hpp"
@@ -103,6 +104,20 @@ TEST_P(RelaxationColumn, WithTheVolumeConstraintReachesTheDampedEquilibrium) {
   EXPECT_LT(difference, 1e-5);
   EXPECT_LT(difference, 2e-3 * damped.max_displacement_m);
   EXPECT_LT(relaxed.steps, damped.steps / 2);
+}
+
+TEST(RelaxationVolume, SparseProjectionsAreRefused) {
+  Scene s = column_scene("linear", Integrator::Relaxation);
+  s.volume.preserve = true;
+  s.volume.every = 4;
+  const test::Model m = test::make_model(s);
+  try {
+    Simulator sim(s, m.lattice, m.elements, cl_context());
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("volume.every"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("never reach equilibrium"), std::string::npos) << e.what();
+  }
 }
 
 // Stopped at tolerance 1e-5, relaxation must be about as close to equilibrium as the tolerance
