@@ -37,10 +37,63 @@ inline real spring_end(int law, global const real* mat, real k, real len, real r
 // projection leaves them; ui, vi are the caller's (already projected). Only connections d_lo ≤ d <
 // d_hi are summed (kernels/integrate.cl, VB_SPLIT: parts of an element's connections on several
 // work-items); 0, 26 for all.
+// Linear springs only (no rest offsets): the force on a free element whose present neighbours all
+// have its E and inverse mass w, which the host marks with a negative E (engine/sim/
+// uniform_neighbourhood.hpp). Then E_ij = E, k = κ_d·h·E and the dashpot's 2ζ·√(k/(2w)) =
+// 2ζ·√(h·E/(2w))·√κ_d, one square root per element: no neighbour modulus to load and no
+// reciprocal or square root per connection (about a quarter of a connection's instructions;
+// docs/PERF_NOTES.md change 22). Otherwise the same connections as lattice_force_pending.
+// VB_UNIFORM_PATH (host: GPUs, linear springs, no rest offsets, no lanes kernels).
+#if VB_UNIFORM_PATH
+VB_INLINE real4 lattice_force_uniform(uint e, real Ei, real4 ui, real4 vi, global const real4* u,
+                                      global const real4* v, VB_LATTICE_PARAMS, VB_PENDING_PARAMS, int d_lo, int d_hi) {
+  const int cell = (int)cell_of[e];
+#if VB_DASHPOT
+  const real damping_e = 2 * dashpot_ratio * sqrt(h * Ei / (2 * ui.w));
+#endif
+  real4 f = (real4)(0);
+#pragma unroll
+  for (int d = 0; d < 26; ++d) {
+    if (d < d_lo || d >= d_hi) continue;
+    const int jn = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
+    const real present = jn >= 0 ? (real)1 : (real)0;
+    const int j = jn >= 0 ? jn : (int)e;
+    real4 uj = u[j], wgj = (real4)(0);
+    pending_u(&uj, &wgj, (uint)j, VB_PENDING_ARGS);
+    const real4 r = (real4)(h * VB_DIR[d][0] + (uj.x - ui.x), h * VB_DIR[d][1] + (uj.y - ui.y),
+                            h * VB_DIR[d][2] + (uj.z - ui.z), 0);
+    const real len_sq = dot3(r, r);
+#if VB_RSQRT
+    const real inv_len_raw = rsqrt(len_sq);
+#else
+    const real inv_len_raw = 1 / sqrt(len_sq);
+#endif
+    const real inv_len = len_sq > 0 ? inv_len_raw : (real)0;
+    const real len = len_sq * inv_len;
+    const real4 n = r * inv_len;
+    const real k = present * (VB_KAPPA[d] * h * Ei);
+    real magnitude = k * (len - h * VB_DIR_LEN[d]);
+#if VB_DASHPOT
+    real4 vj = v[j];
+    pending_v(&vj, wgj, VB_PENDING_ARGS);
+    magnitude += present * (damping_e * VB_SQRT_KAPPA[d]) * dot3(vj - vi, n);
+#endif
+    f += magnitude * n;
+  }
+  return f;
+}
+#endif
+
 VB_INLINE real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
                                       VB_LATTICE_PARAMS, VB_PENDING_PARAMS, int d_lo, int d_hi) {
-  const int cell = (int)cell_of[e];
+#if VB_UNIFORM_PATH
+  const real E_marked = E[e];
+  if (E_marked < 0) return lattice_force_uniform(e, -E_marked, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, d_lo, d_hi);
+  const real Ei = E_marked;
+#else
   const real Ei = E[e];
+#endif
+  const int cell = (int)cell_of[e];
   real4 f = (real4)(0);
 #if VB_HYPER || VB_BIPHASIC
   global const real* mat_i = materials + VB_MAT_STRIDE * tissue_of[e];
@@ -74,7 +127,11 @@ VB_INLINE real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const r
     const real inv_len = len_sq > 0 ? inv_len_raw : (real)0;  // coincident neighbours: no direction, no NaN
     const real len = len_sq * inv_len;
     const real4 n = r * inv_len;
+#if VB_UNIFORM_PATH
+    const real Ej = fabs(E[j]);  // negative: a uniform neighbourhood (lattice_force_uniform)
+#else
     const real Ej = E[j];
+#endif
 #if VB_DASHPOT
     // One reciprocal serves both k and the dashpot's reduced mass 1/(wi + wj) in 2ζ√(k·m_red):
     // q = 1/((Ei + Ej)(wi + wj)), k = κh·2EiEj·(wi + wj)·q, k·m_red = κh·2EiEj·q.

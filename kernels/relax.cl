@@ -7,8 +7,9 @@
 // critical damping of the lowest mode (the Rayleigh quotient the check kernel sums), updated at
 // each check. Gravity still uses the real mass (u.w), so the equilibrium is the real one.
 // With the volume constraint (VB_VOLUME_LAG) the step feels the constraint's lagged pressure, as
-// Heun's predicted stage does (kernels/integrate.cl, less_lag), and the projection after it only
-// corrects what that misses (kernels/volume.cl, lag_update: M ← M + μ, so at equilibrium M = dt·p).
+// Heun's predicted stage does (kernels/integrate.cl, less_lag), and the projection after it,
+// weighted by the same fictitious masses, only corrects what that misses (kernels/volume.cl,
+// lag_update: M ← M + μ, so at equilibrium M = dt·p).
 // With the projection alone the fixed point was no equilibrium of the constrained problem (each
 // step pushes the surface off the constraint by dt²·p·g/m̃, the projection moves it back by the
 // real masses, along the gradient where the step left it): the residual stalled at ~1e-3·F_ref

@@ -7,7 +7,7 @@
 //   per surface element s
 //     0  Σ x_s·g_s·2 (= 6V, positions relative to `centre`: V is homogeneous of degree 3 in them,
 //        so Σ x_s·∂V/∂x_s = 3V by Euler's theorem; no pass over the triangles of its own)
-//     1  Σ w|g|² over surface elements (w = 1/m, 0 for held elements)
+//     1  Σ w|g|² over surface elements (w = 1/m, 0 for held elements; relaxation: 1/m̃)
 //     2  Σ g·v over surface elements (the rate dV/dt)
 //     3  Σ |g|² over free surface elements   4  Σ g·f over free surface elements (with_force only)
 //   and g = ∂V/∂x of every surface element into `grad` (indexed by element).
@@ -30,6 +30,20 @@
 //     is applied: the kernels that read the state next apply x + λ·w·g, v − μ·w·g on the fly
 //     (VB_PENDING_PARAMS, kernels/common.cl), so a projection is one short launch.
 #define VB_VOLUME_SLOTS 5
+
+// Relaxation (kernels/relax.cl) moves elements by their fictitious masses m/relax_scale: its
+// projection weights by the same masses. Weighted by the real ones, μ = (dt·p − M)·s̄ (s̄ a
+// mean of relax_scale over the surface) and its lagged multiplier M ← M + μ diverged wherever
+// s̄ > 2, e.g. soft tissue around a stiff core (test RelaxationVolume.ConvergesAroundAStiffCore).
+#if VB_RELAX
+#define VB_PROJECTION_PARAM , global const real *relax_scale
+#define VB_PROJECTION_ARG , relax_scale
+#define projection_w(w, e) ((w) * relax_scale[e])
+#else
+#define VB_PROJECTION_PARAM
+#define VB_PROJECTION_ARG
+#define projection_w(w, e) (w)
+#endif
 #if VB_VOLUME_PAIRS
 #define VB_INCIDENT uint2
 #else
@@ -59,7 +73,7 @@ inline void volume_item_values(uint i, global const real4* u, global const real4
                                global const uint* triangles,
                                global const uint* surface_elements, global const uint* incident_start,
                                global const VB_INCIDENT* incident, uint n_surface, real4 centre,
-                               global real4* grad, int with_force, real value[VB_VOLUME_SLOTS]) {
+                               global real4* grad, int with_force, real value[VB_VOLUME_SLOTS] VB_PROJECTION_PARAM) {
   for (int k = 0; k < VB_VOLUME_SLOTS; ++k) value[k] = 0;
   if (i < n_surface) {
     const uint e = surface_elements[i];
@@ -90,7 +104,7 @@ inline void volume_item_values(uint i, global const real4* u, global const real4
     g = xyz0(g) / (real)6;
     grad[e] = g;
     const real4 ui = u[e];
-    value[1] = ui.w * dot3(g, g);
+    value[1] = projection_w(ui.w, e) * dot3(g, g);
     value[2] = dot3(g, v[e]);
     if (with_force && ui.w != 0) {
       const real4 f = static_force(e, ui, v[e], u, v, VB_LATTICE_ARGS);
@@ -119,10 +133,11 @@ inline void volume_item_values(uint i, global const real4* u, global const real4
 // Work-group `group`'s partial sums (VB_CHECK_WG items; every work-item of the group must call).
 inline void volume_group_partials(uint group, global const real4* u, global const real4* v, VB_LATTICE_PARAMS,
                                   VB_VOLUME_MESH_PARAMS, global real4* grad, int with_force, global real* partial,
-                                  local real* s) {
+                                  local real* s VB_PROJECTION_PARAM) {
   const uint l = get_local_id(0);
   real value[VB_VOLUME_SLOTS];
-  volume_item_values(group * VB_CHECK_WG + l, u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, with_force, value);
+  volume_item_values(group * VB_CHECK_WG + l, u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, with_force, value
+                     VB_PROJECTION_ARG);
   sum_over_group(s, VB_CHECK_WG, value, l);
   if (l == 0)
     for (int k = 0; k < VB_VOLUME_SLOTS; ++k) partial[group * VB_VOLUME_SLOTS + k] = s[k * VB_CHECK_WG];
@@ -132,7 +147,7 @@ inline void volume_group_partials(uint group, global const real4* u, global cons
 // u, v, the gradient and the partial sums are state arena offsets (kernels/common.cl, VB_STATE_PARAM).
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
 void volume_partials(uint u_at, uint v_at, VB_LATTICE_KERNEL_PARAMS, VB_VOLUME_MESH_KERNEL_PARAMS, uint grad_at,
-                     int with_force, uint partial_at VB_STATE_PARAM) {
+                     int with_force, uint partial_at VB_PROJECTION_PARAM VB_STATE_PARAM) {
   VB_UNPACK_LATTICE;
   VB_UNPACK_MESH;
   global const real4* u = VB_STATE_AT(const real4, u_at);
@@ -140,7 +155,8 @@ void volume_partials(uint u_at, uint v_at, VB_LATTICE_KERNEL_PARAMS, VB_VOLUME_M
   global real4* grad = VB_STATE_AT(real4, grad_at);
   global real* partial = VB_STATE_AT(real, partial_at);
   local real s[VB_VOLUME_SLOTS * VB_CHECK_WG];
-  volume_group_partials(get_group_id(0), u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, with_force, partial, s);
+  volume_group_partials(get_group_id(0), u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, with_force, partial, s
+                        VB_PROJECTION_ARG);
 }
 
 // λ, μ, V, p from the partial sums of `groups` work-groups of `wg` items (every work-item must call
@@ -181,10 +197,10 @@ inline void lag_update(global real* scalars, real mu) {
 }
 
 // x += λ·w·g, v −= μ·w·g on free surface element e.
-inline void volume_apply_one(uint e, global real4* u, global real4* v, real4 g, const real out[4]) {
+inline void volume_apply_one(uint e, global real4* u, global real4* v, real4 g, const real out[4] VB_PROJECTION_PARAM) {
   const real4 ui = u[e];
   if (ui.w == 0) return;
-  const real4 wg = ui.w * g;
+  const real4 wg = projection_w(ui.w, e) * g;
   u[e] = ui + out[0] * wg;
   v[e] = v[e] - out[1] * wg;
 }
@@ -192,7 +208,7 @@ inline void volume_apply_one(uint e, global real4* u, global real4* v, real4 g, 
 // u, v, the gradient, the partial sums and the scalars are state arena offsets.
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
 void volume_apply(uint u_at, uint v_at, global const uchar* mesh, uint4 mesh_at, uint n_surface, uint grad_at,
-                  uint partial_at, uint groups, real rest_volume, uint scalars_at VB_STATE_PARAM) {
+                  uint partial_at, uint groups, real rest_volume, uint scalars_at VB_PROJECTION_PARAM VB_STATE_PARAM) {
   VB_UNPACK_SURFACE;
   global real4* u = VB_STATE_AT(real4, u_at);
   global real4* v = VB_STATE_AT(real4, v_at);
@@ -209,7 +225,7 @@ void volume_apply(uint u_at, uint v_at, global const uchar* mesh, uint4 mesh_at,
   }
   if (i >= n_surface) return;
   const uint e = surface_elements[i];
-  volume_apply_one(e, u, v, grad[e], out);
+  volume_apply_one(e, u, v, grad[e], out VB_PROJECTION_ARG);
 }
 
 // Each work-group's partial sums (and every surface element's g), then the group counts itself;
@@ -217,10 +233,10 @@ void volume_apply(uint u_at, uint v_at, global const uchar* mesh, uint4 mesh_at,
 // gradients through volatile pointers (past the non-coherent L1 on NVIDIA).
 inline int partials_counted(global const real4* u, global const real4* v, VB_LATTICE_PARAMS, VB_VOLUME_MESH_PARAMS,
                             global real4* grad, global real* partial, volatile global uint* groups_done,
-                            local real* s, local int* last, uint wg) {
+                            local real* s, local int* last, uint wg VB_PROJECTION_PARAM) {
   const uint l = get_local_id(0);
   real value[VB_VOLUME_SLOTS];
-  volume_item_values(get_global_id(0), u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, 0, value);
+  volume_item_values(get_global_id(0), u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, 0, value VB_PROJECTION_ARG);
   sum_over_group(s, wg, value, l);
   if (l == 0)
     for (int k = 0; k < VB_VOLUME_SLOTS; ++k) partial[get_group_id(0) * VB_VOLUME_SLOTS + k] = s[k * wg];
@@ -238,14 +254,14 @@ inline int partials_counted(global const real4* u, global const real4* v, VB_LAT
 kernel __attribute__((reqd_work_group_size(VB_VOLUME_WG, 1, 1)))
 void volume_project(global real4* u, global real4* v, VB_LATTICE_KERNEL_PARAMS, VB_VOLUME_MESH_KERNEL_PARAMS,
                     global real4* grad, global real* partial, real rest_volume, global real* scalars,
-                    volatile global uint* groups_done) {
+                    volatile global uint* groups_done VB_PROJECTION_PARAM) {
   VB_UNPACK_LATTICE;
   VB_UNPACK_MESH;
   local real s[VB_VOLUME_SLOTS * VB_VOLUME_WG];
   local int last;
   const uint l = get_local_id(0);
   if (!partials_counted(u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, partial, groups_done, s, &last,
-                        VB_VOLUME_WG))
+                        VB_VOLUME_WG VB_PROJECTION_ARG))
     return;
   // The last group: the other groups' partials and gradients are read past any cache (volatile).
   real out[4];
@@ -261,7 +277,7 @@ void volume_project(global real4* u, global real4* v, VB_LATTICE_KERNEL_PARAMS, 
     }
     for (int r = 0; r < 4; ++r) g[r] = e[r] != 0xffffffffu ? g_all[e[r]] : (real4)(0);
     for (int r = 0; r < 4; ++r)
-      if (e[r] != 0xffffffffu) volume_apply_one(e[r], u, v, g[r], out);
+      if (e[r] != 0xffffffffu) volume_apply_one(e[r], u, v, g[r], out VB_PROJECTION_ARG);
   }
   if (l == 0) {
     lag_update(scalars, out[1]);
@@ -277,14 +293,14 @@ void volume_project(global real4* u, global real4* v, VB_LATTICE_KERNEL_PARAMS, 
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
 void volume_pending(global const real4* u, global const real4* v, VB_LATTICE_KERNEL_PARAMS, VB_VOLUME_MESH_KERNEL_PARAMS,
                     global real4* grad, global real* partial, real rest_volume, global real* scalars,
-                    volatile global uint* groups_done) {
+                    volatile global uint* groups_done VB_PROJECTION_PARAM) {
   VB_UNPACK_LATTICE;
   VB_UNPACK_MESH;
   local real s[VB_VOLUME_SLOTS * VB_CHECK_WG];
   local int last;
   const uint l = get_local_id(0);
   if (!partials_counted(u, v, VB_LATTICE_ARGS, VB_VOLUME_MESH_ARGS, grad, partial, groups_done, s, &last,
-                        VB_CHECK_WG))
+                        VB_CHECK_WG VB_PROJECTION_ARG))
     return;
   real out[4];
   volume_scalars(partial, get_num_groups(0), rest_volume, s, VB_CHECK_WG, l, out);

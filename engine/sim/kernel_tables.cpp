@@ -1,5 +1,6 @@
 #include "engine/sim/kernel_tables.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -28,6 +29,8 @@ std::string lattice_tables_source() {
   for (int d = 0; d < 26; ++d) s << "(real)" << exact(ls::rest_length_factor(d)) << ",";
   s << "};\n__constant real VB_KAPPA[26] = {";
   for (int d = 0; d < 26; ++d) s << "(real)" << exact(ls::kappa(d)) << ",";
+  s << "};\n__constant real VB_SQRT_KAPPA[26] = {";  // lattice_force_uniform's dashpots
+  for (int d = 0; d < 26; ++d) s << "(real)" << exact(std::sqrt(ls::kappa(d))) << ",";
   s << "};\n__constant uint VB_OCTANT_MASK[8] = {";
   for (const std::uint32_t m : octant_masks()) s << m << "u,";
   s << "};\n";

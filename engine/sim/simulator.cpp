@@ -10,6 +10,7 @@
 #include "engine/error.hpp"
 #include "engine/sim/kernel_tables.hpp"
 #include "engine/sim/triangle_contact.hpp"
+#include "engine/sim/uniform_neighbourhood.hpp"
 #include "engine/surface/enclosed_volume.hpp"
 #include "engine/surface/surface_area.hpp"
 
@@ -264,6 +265,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_INDENTERS=" + std::to_string(scene.indenters.size());
   options += " -DVB_CHECK_SLOTS=" + std::to_string(check_slots_);
   options += " -DVB_RSQRT=" + std::to_string(cl.info.is_gpu);
+  options += " -DVB_UNIFORM_PATH=" + std::to_string(uniform_path_);
   // Denormal floats (< 1.2e-38: nothing in m, N, Pa) flushed to zero on GPUs: NVIDIA's rsqrt,
   // rcp and sqrt then skip their denormal fix-up: the 1.5M linear Heun float step 3-4.5% shorter
   // on the H200 (device time).
@@ -436,6 +438,13 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
            scene.indenters.empty() && scene.tori.empty() && !tri_contact_ && !folded && !rest_offsets_ &&
            force_split_ == 1;
   if (const char* env = std::getenv("VOXBREAST_LANES")) lanes_ = lanes_ && std::atoi(env) != 0;
+  // Linear springs on GPUs: elements whose neighbours share their E and mass take a short
+  // connection loop (kernels/lattice_forces.cl, lattice_force_uniform; PERF_NOTES.md change 22),
+  // marked by a negative E. Not with the lanes kernels (they would need it without a branch,
+  // where it saves nothing on a CPU). VOXBREAST_UNIFORM_PATH=0|1 overrides, on any device.
+  uniform_path_ = cl.info.is_gpu && !el.hyperelastic && !el.biphasic && !rest_offsets_;
+  if (const char* env = std::getenv("VOXBREAST_UNIFORM_PATH"))
+    uniform_path_ = !el.hyperelastic && !el.biphasic && !rest_offsets_ && !lanes_ && std::atoi(env) != 0;
   // Heun's whole step in one launch where the device allows it (kernels/persistent.cl): not with
   // triangle contact (its own pass) or folded projections (another way to fewer launches).
   persistent_ = plan_persistent_step(cl.info, heun_steps && !tri_contact_ && !folded, el.hyperelastic, n_,
@@ -636,6 +645,12 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh, const std::vector<c
     k.setArg(last - 2, at(vol_grad_));
     k.setArg(last - 1, at(vol_scalars_));
   }
+  if (relax_) {  // the projection weights by relaxation's masses (kernels/volume.cl, VB_PROJECTION_PARAM)
+    const auto from_end = [&](cl::Kernel& k, cl_uint back) { k.setArg(k.getInfo<CL_KERNEL_NUM_ARGS>() - back, relax_scale_); };
+    from_end(vol_partials_, 2);  // before the state arena
+    from_end(vol_apply_, 2);
+    from_end(vol_project_, 1);
+  }
   set_rest_volume_args();
   check_.setArg(kCheckVolume, vol_grad_);
   check_.setArg(kCheckVolume + 1, vol_scalars_);
@@ -749,7 +764,10 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
   std::vector<double> table;
   for (const auto& row : el.material_table) table.insert(table.end(), row.begin(), row.end());
   if (!per_tissue) table.assign(12, 0.0);
-  const std::vector<unsigned char> E = real_bytes(el.youngs_modulus_pa), materials = real_bytes(table);
+  const std::vector<unsigned char> E = real_bytes(
+      uniform_path_ ? mark_uniform_neighbourhoods(el.youngs_modulus_pa, inverse_mass_, grid, cell_of, stride_y_, stride_z_)
+                    : el.youngs_modulus_pa);
+  const std::vector<unsigned char> materials = real_bytes(table);
   // kernels/hyperelastic.cl, hyper_store: Q's 3 rows (C = FᵀF's diagonal in w), C's other entries
   const std::size_t row_bytes = (hyper_ ? n_ : 1) * 4 * real_size_;
   const std::size_t slot[8] = {
