@@ -438,17 +438,19 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
            scene.indenters.empty() && scene.tori.empty() && !tri_contact_ && !folded && !rest_offsets_ &&
            force_split_ == 1;
   if (const char* env = std::getenv("VOXBREAST_LANES")) lanes_ = lanes_ && std::atoi(env) != 0;
-  // Linear springs on GPUs: elements whose neighbours share their E and mass take a short
-  // connection loop (kernels/lattice_forces.cl, lattice_force_uniform; PERF_NOTES.md change 22),
-  // marked by a negative E. Not with the lanes kernels (they would need it without a branch,
-  // where it saves nothing on a CPU). VOXBREAST_UNIFORM_PATH=0|1 overrides, on any device.
-  uniform_path_ = cl.info.is_gpu && !el.hyperelastic && !el.biphasic && !rest_offsets_;
-  if (const char* env = std::getenv("VOXBREAST_UNIFORM_PATH"))
-    uniform_path_ = !el.hyperelastic && !el.biphasic && !rest_offsets_ && !lanes_ && std::atoi(env) != 0;
   // Heun's whole step in one launch where the device allows it (kernels/persistent.cl): not with
   // triangle contact (its own pass) or folded projections (another way to fewer launches).
   persistent_ = plan_persistent_step(cl.info, heun_steps && !tri_contact_ && !folded, el.hyperelastic, n_,
                                      force_split_, kSplitMaxElements);
+  // Linear springs on GPUs: elements whose neighbours share their E and mass take a short
+  // connection loop (kernels/lattice_forces.cl, lattice_force_uniform; PERF_NOTES.md change 22),
+  // marked by a negative E. Not in the one-launch step, whose register cap the second loop
+  // overflows (36k cube 72.9k → 47.9k steps/s on the H200), nor with the lanes kernels (they would
+  // need it without a branch, which saves nothing on a CPU). VOXBREAST_UNIFORM_PATH=0|1 overrides
+  // the device rule, not the others.
+  const bool uniform_allowed = !el.hyperelastic && !el.biphasic && !rest_offsets_ && !lanes_ && !persistent_.on;
+  uniform_path_ = uniform_allowed && cl.info.is_gpu;
+  if (const char* env = std::getenv("VOXBREAST_UNIFORM_PATH")) uniform_path_ = uniform_allowed && std::atoi(env) != 0;
   // Heun's predicted stage under the last correction's pressure instead of a projection of its
   // own (docs/PHYSICS.md, "Volume preservation"): one launch fewer per step on CPUs, two on GPUs.
   // Projected as before when the scene asks, between corrections (every > 1: no multiplier to
