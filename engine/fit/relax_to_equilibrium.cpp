@@ -8,7 +8,8 @@
 
 namespace vb {
 
-std::int64_t relax_to_equilibrium(Simulator& sim, const Scene& scene, const EquilibriumScales& scales, const Vec3& g, const char* posture) {
+std::int64_t relax_to_equilibrium(Simulator& sim, const Scene& scene, const EquilibriumScales& scales, const Vec3& g,
+                                  const char* posture) {
   sim.set_gravity(g);
   sim.restart_clock();
   const std::int64_t every = std::max(1, scene.solver.check_every);
