@@ -336,7 +336,9 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                                                                                  : nlohmann::json("projection")},
                           {"force_split", sim.force_split()}, {"persistent_step", sim.persistent_step()},
                           {"stress_pair", sim.stress_pair()}, {"stress_pass_elements", sim.stress_pass_elements()},
-                          {"lanes_kernels", sim.lanes()}};
+                          {"lanes_kernels", sim.lanes()},
+                          // elements on the short connection loop (PERF_NOTES.md change 22)
+                          {"uniform_loop_elements", sim.uniform_elements()}};
     csv << c.name << "," << n << "," << c.law << "," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
         << "\n";

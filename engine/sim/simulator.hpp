@@ -159,8 +159,10 @@ class Simulator {
   int volume_launches() const { return volume_launches_; }
   /// Whether Heun's predicted stage feels the lagged constraint pressure instead of being projected.
   bool volume_predictor_pressure() const { return volume_lag_ && !relax_; }
-  /// Whether elements with a uniform neighbourhood take the short connection loop (linear springs).
+  /// Whether elements with a uniform neighbourhood take the short connection loop (linear springs),
+  /// and how many do (engine/sim/uniform_neighbourhood.hpp).
   bool uniform_path() const { return uniform_path_; }
+  std::size_t uniform_elements() const { return uniform_elements_; }
   /// The volume constraint's scalars as the last kernel left them (kernels/volume.cl; lattice
   /// frame): the last correction's λ (m³ per unit w|g|²) and μ, the last sums' volume V (m³) and
   /// pressure p (Pa, computed by check()), and the lagged multiplier M (Pa·s: M/dt is the pressure
@@ -337,6 +339,7 @@ class Simulator {
   bool stress_pair_ = false;  ///< Heun's two element stresses in one launch (VB_STRESS_PAIR)
   bool volume_lag_ = false;  ///< Heun's predicted stage (relaxation's step) under the lagged pressure
   bool uniform_path_ = false;  ///< linear springs: uniform neighbourhoods marked, their short loop compiled in
+  std::size_t uniform_elements_ = 0;  ///< elements marked
   DeviceArena vol_mesh_;  ///< triangles, surface elements, incident start, incident (kernels/volume.cl)
   cl_uint4 vol_mesh_at_{};
   cl::Buffer vol_grad_, vol_partial_,

@@ -84,6 +84,10 @@ std::vector<double> run(const Scene& s, bool uniform) {
   unsetenv("VOXBREAST_UNIFORM_PATH");
   unsetenv("VOXBREAST_PERSISTENT");
   EXPECT_EQ(sim.uniform_path(), uniform);
+  // most of the block's free elements, not those next to the inclusion, the heavy layer or the base
+  if (uniform) EXPECT_GT(sim.uniform_elements(), m.lattice.element_count() / 5);
+  if (uniform) EXPECT_LT(sim.uniform_elements(), m.lattice.element_count() * 4 / 5);
+  if (!uniform) EXPECT_EQ(sim.uniform_elements(), 0u);
   for (int k = 0; k < 3; ++k) {
     sim.advance(100);
     EXPECT_EQ(sim.check().nonfinite_elements, 0);
