@@ -767,8 +767,7 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
   for (const auto& row : el.material_table) table.insert(table.end(), row.begin(), row.end());
   if (!per_tissue) table.assign(12, 0.0);
   const std::vector<double> marked_E =
-      uniform_path_ ? mark_uniform_neighbourhoods(el.youngs_modulus_pa, inverse_mass_, grid, cell_of, stride_y_, stride_z_)
-                    : el.youngs_modulus_pa;
+      uniform_path_ ? mark_uniform_neighbourhoods(lattice_, el.youngs_modulus_pa, inverse_mass_) : el.youngs_modulus_pa;
   uniform_elements_ = std::size_t(std::count_if(marked_E.begin(), marked_E.end(), [](double E) { return E < 0; }));
   const std::vector<unsigned char> E = real_bytes(marked_E);
   const std::vector<unsigned char> materials = real_bytes(table);

@@ -3,6 +3,7 @@
 // on by default on GPUs, VOXBREAST_UNIFORM_PATH=1 forces it here) against the general loop.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
@@ -17,34 +18,29 @@
 namespace vb {
 namespace {
 
-// A 5×5×5 block in a padded 7×7×7 grid: element (1,1,1) has another modulus, (3,3,3) is held.
-// Marked: every free element whose 3×3×3 neighbourhood holds neither, also on the block's faces
-// (missing neighbours do not count): 125 − 27 − 27 + 1 (the shared (2,2,2)) = 72.
+// A 5×5×5 block: element (1,1,1) has another modulus, (3,3,3) is held. Marked: every free
+// element whose 3×3×3 neighbourhood holds neither, also on the block's faces (missing neighbours
+// do not count): 125 − 27 − 27 + 1 (the shared (2,2,2)) = 72.
 TEST(UniformNeighbourhood, MarksElementsWhoseNeighboursShareModulusAndMass) {
-  const int n = 5, sy = n + 2, sz = sy * sy;
-  std::vector<std::int32_t> grid(std::size_t(sz * sy), -1);
-  std::vector<std::uint32_t> cell_of;
-  std::vector<double> E, w;
-  const auto index = [&](int i, int j, int k) { return (i * n + j) * n + k; };
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k) {
-        const std::uint32_t cell = std::uint32_t((k + 1) + sy * (j + 1) + sz * (i + 1));
-        grid[cell] = std::int32_t(cell_of.size());
-        cell_of.push_back(cell);
-        E.push_back(i == 1 && j == 1 && k == 1 ? 6000 : 3000);
-        w.push_back(i == 3 && j == 3 && k == 3 ? 0 : 0.5);
-      }
-  const std::vector<double> marked = mark_uniform_neighbourhoods(E, w, grid, cell_of, sy, sz);
+  const test::Model m = test::make_model(test::box_scene(5, 5, 5, 0.004));
+  const std::size_t n = m.lattice.element_count();
+  ASSERT_EQ(n, 125u);
+  const auto at = [&](std::size_t e, int c) {
+    const auto ijk = m.lattice.voxel_ijk(e);
+    return std::abs(ijk[0] - c) <= 1 && std::abs(ijk[1] - c) <= 1 && std::abs(ijk[2] - c) <= 1;
+  };
+  const auto is = [&](std::size_t e, int c) { return m.lattice.voxel_ijk(e) == std::array<int, 3>{c, c, c}; };
+  std::vector<double> E(n, 3000), w(n, 0.5);
+  for (std::size_t e = 0; e < n; ++e) {
+    if (is(e, 1)) E[e] = 6000;
+    if (is(e, 3)) w[e] = 0;
+  }
+  const std::vector<double> marked = mark_uniform_neighbourhoods(m.lattice, E, w);
   int count = 0;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k) {
-        const auto near = [&](int c) { return std::abs(i - c) <= 1 && std::abs(j - c) <= 1 && std::abs(k - c) <= 1; };
-        const double m = marked[std::size_t(index(i, j, k))], e = E[std::size_t(index(i, j, k))];
-        EXPECT_EQ(m, near(1) || near(3) ? e : -e) << i << "," << j << "," << k;
-        count += m < 0;
-      }
+  for (std::size_t e = 0; e < n; ++e) {
+    EXPECT_EQ(marked[e], at(e, 1) || at(e, 3) ? E[e] : -E[e]) << e;
+    count += marked[e] < 0;
+  }
   EXPECT_EQ(count, 72);
 }
 
