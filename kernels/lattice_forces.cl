@@ -25,25 +25,13 @@ inline real spring_end(int law, global const real* mat, real k, real len, real r
 #define spring_end(law, mat, k, len, rest) ((real)0.5 * (k) * ((len) - (rest)))
 #endif
 
-// Force on element e from its connections (N). Linear-spring tissues: springs k = κ_d·h·E_ij.
-// Hyperelastic tissues (VB_HYPER): the element stresses of pass 1 (Q·h·d from each neighbour,
-// Q_e·Σh·d from the element itself) plus hourglass control. Per connection, each end adds half a
-// spring: a linear end ½k(|r| − L), a biphasic end ½k·L·g(ε) (VB_BIPHASIC), a hyperelastic end
-// c_hg·k(|r| − |F·r₀|), whose rest length is the length its own affine fit predicts, so affine
-// fields feel no hourglass force (r₀ the connection at rest: h·d, or h·d + Δu0 with rest offsets,
-// F the element's deformation from rest).
-// u: displacement (m) with w = inverse mass (1/kg, 0 = held); v: velocity (m/s). With a pending
-// volume projection (VB_PENDING_PARAMS, kernels/common.cl) the neighbours' u, v are read as the
-// projection leaves them; ui, vi are the caller's (already projected). Only connections d_lo ≤ d <
-// d_hi are summed (kernels/integrate.cl, VB_SPLIT: parts of an element's connections on several
-// work-items); 0, 26 for all.
 // Linear springs only (no rest offsets): the force on a free element whose present neighbours all
 // have its E and inverse mass w, which the host marks with a negative E (engine/sim/
 // uniform_neighbourhood.hpp). Then E_ij = E, k = κ_d·h·E and the dashpot's 2ζ·√(k/(2w)) =
 // 2ζ·√(h·E/(2w))·√κ_d, one square root per element: no neighbour modulus to load and no
 // reciprocal or square root per connection (about a quarter of a connection's instructions;
 // docs/PERF_NOTES.md change 22). Otherwise the same connections as lattice_force_pending.
-// VB_UNIFORM_PATH (host: GPUs, linear springs, no rest offsets, no lanes kernels).
+// VB_UNIFORM_PATH (host: GPUs, linear springs, no rest offsets, not in the one-launch step).
 #if VB_UNIFORM_PATH
 VB_INLINE real4 lattice_force_uniform(uint e, real Ei, real4 ui, real4 vi, global const real4* u,
                                       global const real4* v, VB_LATTICE_PARAMS, VB_PENDING_PARAMS, int d_lo, int d_hi) {
@@ -84,6 +72,18 @@ VB_INLINE real4 lattice_force_uniform(uint e, real Ei, real4 ui, real4 vi, globa
 }
 #endif
 
+// Force on element e from its connections (N). Linear-spring tissues: springs k = κ_d·h·E_ij.
+// Hyperelastic tissues (VB_HYPER): the element stresses of pass 1 (Q·h·d from each neighbour,
+// Q_e·Σh·d from the element itself) plus hourglass control. Per connection, each end adds half a
+// spring: a linear end ½k(|r| − L), a biphasic end ½k·L·g(ε) (VB_BIPHASIC), a hyperelastic end
+// c_hg·k(|r| − |F·r₀|), whose rest length is the length its own affine fit predicts, so affine
+// fields feel no hourglass force (r₀ the connection at rest: h·d, or h·d + Δu0 with rest offsets,
+// F the element's deformation from rest).
+// u: displacement (m) with w = inverse mass (1/kg, 0 = held); v: velocity (m/s). With a pending
+// volume projection (VB_PENDING_PARAMS, kernels/common.cl) the neighbours' u, v are read as the
+// projection leaves them; ui, vi are the caller's (already projected). Only connections d_lo ≤ d <
+// d_hi are summed (kernels/integrate.cl, VB_SPLIT: parts of an element's connections on several
+// work-items); 0, 26 for all.
 VB_INLINE real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
                                       VB_LATTICE_PARAMS, VB_PENDING_PARAMS, int d_lo, int d_hi) {
 #if VB_UNIFORM_PATH
