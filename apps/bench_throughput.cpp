@@ -273,13 +273,18 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
   if (o.profile) print_launch_floor(cl);
 
   std::vector<BenchCase> cases;
-  std::optional<bench::BenchScene> breast;  // the scene as the phantom runs it, each law applied per case
-  if (!o.breast_scene.empty()) {
-    breast = bench::image_scene("breast", o.breast_scene, kBreastSpacing);
+  // the phantom's scenes as it runs them, each law applied per case (cases with edge 0)
+  std::optional<bench::BenchScene> breast, breast_large;
+  if (o.breast) {
+    breast = bench::image_scene("breast", o.phantom_scene, kBreastSpacing);
     for (const std::string& law : o.laws) {
       cases.push_back({"breast", 0, Integrator::Heun, Precision::Float, law});
       if (o.volume) cases.push_back({"breast_volume", 0, Integrator::Heun, Precision::Float, law, true});
     }
+  }
+  if (o.breast_large) {
+    breast_large = bench::image_scene("breast_large", o.phantom_scene, bench::kLargePhantomSpacing);
+    cases.push_back({"breast_large", 0, Integrator::Heun, Precision::Float, "linear"});
   }
   for (int edge : sizes) {
     cases.push_back({"block", edge, Integrator::Heun, Precision::Float});
@@ -296,17 +301,18 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
   nlohmann::json rows = nlohmann::json::array();
   std::ostringstream csv;
   csv << "model,elements,law,integrator,precision,steps_per_s,ns_per_element_step,bytes_per_element_step,"
-         "effective_bandwidth_gb_s,fraction_of_copy_bandwidth,device_bytes_per_element\n";
+         "effective_bandwidth_gb_s,fraction_of_copy_bandwidth,device_bytes_per_element,free_elements\n";
   for (const BenchCase& c : cases) {
     Scene scene;
     Lattice lattice;
     if (c.edge == 0) {  // the breast: its tissues (muscle rigid) on the case's law, Heun, float
-      scene = breast->scene;
+      const bench::BenchScene& breast_case = c.name == "breast_large" ? *breast_large : *breast;
+      scene = breast_case.scene;
       bench::apply_law(scene, c.law);
       scene.solver.integrator = c.integrator;
       scene.solver.precision = c.precision;
       scene.volume.preserve = c.volume;
-      lattice = build_lattice(breast->volume);
+      lattice = build_lattice(breast_case.volume);
     } else {
       scene = block_scene(c);
       lattice = build_lattice(voxelise_shapes(scene));
@@ -316,16 +322,19 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     Simulator sim(scene, lattice, el, cl);
     const double sps = time_steps(sim, target_s);
     const std::size_t n = lattice.element_count();
+    // A step moves the bytes of the elements it steps: held ones are only read as neighbours
+    // (most of the phantom's rigid chest wall not at all).
+    const std::size_t n_free = n - el.held_count;
     const std::size_t real_size = c.precision == Precision::Double ? 8 : 4;
     const bool heun = c.integrator == Integrator::Heun;
     const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, c.law);
-    const double effective = bytes * double(n) * sps;
+    const double effective = bytes * double(n_free) * sps;
     const char* integ = heun ? "heun" : "symplectic_euler";
     const char* prec = c.precision == Precision::Double ? "double" : "float";
-    std::printf("%-12s %9zu elements  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
-                c.name.c_str(), n, c.law.c_str(), integ, prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
+    std::printf("%-12s %9zu elements (%zu free)  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
+                c.name.c_str(), n, n_free, c.law.c_str(), integ, prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
     std::fflush(stdout);
-    nlohmann::json row = {{"model", c.name}, {"elements", n}, {"law", c.law}, {"integrator", integ}, {"precision", prec},
+    nlohmann::json row = {{"model", c.name}, {"elements", n}, {"free_elements", n_free}, {"law", c.law}, {"integrator", integ}, {"precision", prec},
                           {"steps_per_s", sps}, {"bytes_per_element_step", bytes}, {"effective_bandwidth_gb_s", effective / 1e9},
                           {"fraction_of_copy_bandwidth", effective / bandwidth},
                           {"device_bytes_per_element", double(sim.device_bytes()) / double(n)},
@@ -338,10 +347,11 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                           {"stress_pair", sim.stress_pair()}, {"stress_pass_elements", sim.stress_pass_elements()},
                           {"lanes_kernels", sim.lanes()},
                           // elements on the short connection loop (PERF_NOTES.md change 22)
-                          {"uniform_loop_elements", sim.uniform_elements()}};
+                          {"uniform_loop_elements", sim.uniform_elements()},
+                          {"step_list", sim.step_list()}};
     csv << c.name << "," << n << "," << c.law << "," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
-        << "\n";
+        << "," << n_free << "\n";
     if (o.profile) {
       // Which side sets the pace: the host's launches (enqueue time close to the step) or the
       // device (its time alone close to the step).

@@ -17,9 +17,10 @@ struct ThroughputOptions {
   bool volume = false;   ///< also time each law with [volume] preserve = true (model "block_volume")
   VolumeSpec::Predictor volume_predictor = VolumeSpec::Predictor::Pressure;  ///< [volume] predictor of those
   bool profile = false;  ///< print device time per kernel (a second, profiling run of each block)
-  /// the breast phantom's scene.toml: also time it resampled to ~36k elements (models "breast",
-  /// "breast_volume"), every law; empty: blocks only
-  std::string breast_scene;
+  std::string phantom_scene;  ///< the breast phantom's scene.toml, for the two options below
+  /// also time the phantom resampled to ~36k elements (models "breast", "breast_volume"), every law
+  bool breast = false;
+  bool breast_large = false;  ///< also time it at ~1.5M elements (model "breast_large"), linear springs
 };
 
 struct ThroughputResult {

@@ -85,6 +85,17 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
 // array's offset in units of VB_ARENA_UNIT bytes in `at`: E, cell_of, grid, tissue_of, materials,
 // Q rows, C, rest offsets. VB_UNPACK_LATTICE at the top of a kernel names them as above.
 #define VB_ARENA_AT(arena, slot) ((arena) + (size_t)(slot) * VB_ARENA_UNIT)
+// The element stepping work-item i moves, and the bound to test it against (`n`, `arena` in
+// scope). VB_STEP_LIST (GPUs; engine/sim/simulator.cpp): the free elements' list in the model
+// arena at VB_STEP_LIST_AT, n its length; held elements get no work-item, and past the end the
+// element is UINT_MAX, which fails every bound. Otherwise element i of n.
+#if VB_STEP_LIST
+#define VB_STEP_INDEX(i) ((i) < n ? ((global const uint*)VB_ARENA_AT(arena, VB_STEP_LIST_AT))[i] : UINT_MAX)
+#define VB_STEP_N UINT_MAX
+#else
+#define VB_STEP_INDEX(i) (i)
+#define VB_STEP_N n
+#endif
 #define VB_LATTICE_KERNEL_PARAMS                                                                 \
   global const uchar *arena, uint8 at, int sy, int sz, real h, real dashpot_ratio, real4 gravity, \
       real damping, real4 origin, real hourglass

@@ -175,7 +175,7 @@ kernel void euler_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENT
                        uint n VB_TRI_PARAMS VB_STATE_PARAM) {
   VB_UNPACK_LATTICE;
   VB_UNPACK_STEP_STATE(const, );
-  explicit_stage(get_global_id(0), u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 1, VB_NO_PENDING,
+  explicit_stage(VB_STEP_INDEX(get_global_id(0)), u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, VB_STEP_N, 1, VB_NO_PENDING,
                  VB_NO_LAG VB_TRI_ARGS);
 }
 
@@ -260,7 +260,7 @@ VB_INLINE void correct_element(uint e, global real4* u, global real4* v, global 
 #define VB_STEP_ELEMENT split_element(get_group_id(0))
 #define VB_STEP_SHARE local real4 share[VB_SPLIT_WG]
 #else
-#define VB_STEP_ELEMENT get_global_id(0)
+#define VB_STEP_ELEMENT VB_STEP_INDEX(get_global_id(0))
 #define VB_STEP_SHARE local real4* share = 0
 #endif
 
@@ -270,7 +270,7 @@ kernel VB_STEP_ATTR void heun_predict(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PA
   VB_UNPACK_LATTICE;
   VB_UNPACK_STEP_STATE(const, );
   VB_STEP_SHARE;
-  predict_element(VB_STEP_ELEMENT, u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n,
+  predict_element(VB_STEP_ELEMENT, u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, VB_STEP_N,
                   VB_FOLD_PENDING(state), VB_LAG_KERNEL_ARGS, share VB_TRI_ARGS);
 }
 
@@ -281,6 +281,6 @@ kernel VB_STEP_ATTR void heun_correct(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PA
   VB_UNPACK_LATTICE;
   VB_UNPACK_STEP_STATE(, const);
   VB_STEP_SHARE;
-  correct_element(VB_STEP_ELEMENT, u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n,
+  correct_element(VB_STEP_ELEMENT, u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, VB_STEP_N,
                   VB_FOLD_PENDING(state), VB_FOLD_PENDING(pred), share VB_TRI_ARGS);
 }

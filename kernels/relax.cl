@@ -18,8 +18,8 @@ kernel void relax_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENT
                        uint n, global const real* relax_scale, real c VB_LAG_KERNEL_PARAMS VB_TRI_PARAMS VB_STATE_PARAM) {
   VB_UNPACK_LATTICE;
   VB_UNPACK_STEP_STATE(const, );
-  const uint e = get_global_id(0);
-  if (e >= n) return;
+  const uint e = VB_STEP_INDEX(get_global_id(0));
+  if (e >= VB_STEP_N) return;
   real4 ui = u[e], vi = v[e];
   if (ui.w != 0) {
     // acceleration() is f/m with the indenters' constraint (no global damping is compiled in);

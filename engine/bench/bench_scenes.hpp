@@ -33,6 +33,10 @@ struct BenchScene {
 /// plane. Damping γ = 2ω₁ (critical for the first axial mode).
 BenchScene column_scene(int nxy, int nz, double spacing_m);
 
+/// Lattice spacing that resamples the bundled phantom (18,413 elements at 4 mm) to about 1.5M
+/// elements: 4 mm × (18,413 / 1.5M)^(1/3) (the study's phantom_large, the throughput's breast_large).
+constexpr double kLargePhantomSpacing = 0.00092;
+
 /// A CT scene (the bundled phantom's scene.toml) resampled at `spacing_m` (0: the scene's own).
 /// Throws vb::Error when the scene is not an image scene or its files cannot be read.
 BenchScene image_scene(const std::string& name, const std::string& scene_path, double spacing_m);

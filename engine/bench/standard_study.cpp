@@ -8,10 +8,6 @@
 namespace vb::bench {
 namespace {
 
-/// Lattice spacing that resamples the bundled phantom (18,413 elements at 4 mm) to about 1.5M
-/// elements: 4 mm × (18,413 / 1.5M)^(1/3).
-constexpr double kLargePhantomSpacing = 0.00092;
-
 bool wanted(const std::vector<std::string>& only, const std::string& name) {
   return only.empty() || std::find(only.begin(), only.end(), name) != only.end();
 }

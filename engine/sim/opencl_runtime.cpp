@@ -9,6 +9,8 @@
 #include <map>
 #include <mutex>
 
+#include <CL/cl_ext.h>
+
 #include "engine/error.hpp"
 
 namespace vb::kernels {
@@ -28,6 +30,20 @@ std::string trim(std::string s) {
   return s;
 }
 
+/// The vendor's own query where the device has it (cl_nv_device_attribute_query,
+/// cl_amd_device_attribute_query); 64, a multiple of both, for other GPUs; 1 for CPUs.
+unsigned simd_width(const cl::Device& d, bool is_gpu) {
+  if (!is_gpu) return 1;
+  const std::string extensions = d.getInfo<CL_DEVICE_EXTENSIONS>();
+  const auto query = [&](cl_device_info what) {
+    cl_uint width = 0;
+    return clGetDeviceInfo(d(), what, sizeof width, &width, nullptr) == CL_SUCCESS && width > 0 ? unsigned(width) : 64u;
+  };
+  if (extensions.find("cl_nv_device_attribute_query") != std::string::npos) return query(CL_DEVICE_WARP_SIZE_NV);
+  if (extensions.find("cl_amd_device_attribute_query") != std::string::npos) return query(CL_DEVICE_WAVEFRONT_WIDTH_AMD);
+  return 64;
+}
+
 DeviceInfo describe(const cl::Platform& platform, const cl::Device& d, int index) {
   DeviceInfo info;
   info.index = index;
@@ -42,6 +58,7 @@ DeviceInfo describe(const cl::Platform& platform, const cl::Device& d, int index
   info.global_memory_bytes = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
   info.max_allocation_bytes = d.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
   info.compute_units = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
+  info.simd_width = simd_width(d, info.is_gpu);
   return info;
 }
 

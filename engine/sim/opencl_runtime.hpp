@@ -15,6 +15,9 @@ struct DeviceInfo {
   std::uint64_t global_memory_bytes = 0;
   std::uint64_t max_allocation_bytes = 0;
   unsigned compute_units = 0;
+  /// work-items that execute in lockstep (NVIDIA's warp, AMD's wavefront; 64 for other GPUs, 1
+  /// for CPUs): a branch taken differently inside such a group runs both sides
+  unsigned simd_width = 1;
   cl::Device device;
 };
 

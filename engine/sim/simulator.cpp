@@ -17,6 +17,14 @@
 namespace vb {
 namespace {
 
+/// The free elements in ascending order (the lanes kernels' and the step list's work-items).
+std::vector<cl_uint> free_elements(const std::vector<double>& inverse_mass) {
+  std::vector<cl_uint> list;
+  for (std::size_t e = 0; e < inverse_mass.size(); ++e)
+    if (inverse_mass[e] != 0) list.push_back(cl_uint(e));
+  return list;
+}
+
 constexpr int kCheckWorkGroup = 128;
 // volume_project's work-groups on GPUs (kernels/volume.cl): its last group applies the projection
 // to the whole surface, so wide groups keep that tail short
@@ -298,13 +306,17 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_VOLUME_FOLD=" + std::to_string(volume_ && volume_launches_ == 0);
   options += " -DVB_SPLIT=" + std::to_string(force_split_);
   options += " -DVB_LANES=" + std::to_string(lanes_);
+  options += " -DVB_STEP_LIST=" + std::to_string(step_list_) + " -DVB_STEP_LIST_AT=" + std::to_string(step_list_at_) + "u";
   options += " -DVB_NV_PTX=" + std::to_string(nvidia_ptx(cl.info));
   options += persistent_.options();
   options += " -DVB_VOLUME_LAG=" + std::to_string(volume_lag_);
   options += " -DVB_STRESS_PAIR=" + std::to_string(stress_pair_);
   {
     const std::size_t per = kSplitWorkGroup / std::size_t(force_split_);
-    step_global_ = force_split_ > 1 ? cl::NDRange((n_ + per - 1) / per * kSplitWorkGroup) : global_;
+    const std::size_t wg = kCheckWorkGroup;
+    step_global_ = force_split_ > 1 ? cl::NDRange((n_ + per - 1) / per * kSplitWorkGroup)
+                   : step_list_     ? cl::NDRange(std::max<std::size_t>(1, (step_list_n_ + wg - 1) / wg) * wg)
+                                    : global_;
     step_local_ = force_split_ > 1 ? cl::NDRange(kSplitWorkGroup) : local_;
   }
   const bool friction = std::any_of(scene.tori.begin(), scene.tori.end(), [](const TorusSpec& t) { return t.friction > 0; }) ||
@@ -372,7 +384,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     set_indenter_times(*k, kStepIndenter, 0.0, 0.0);
     set_state_arena_arg(*k);
     set_real(*k, kStepIndenter + kIndenterArgs, dt_.dt_s);
-    k->setArg(kStepIndenter + kIndenterArgs + 1, cl_uint(n_));
+    k->setArg(kStepIndenter + kIndenterArgs + 1, cl_uint(step_list_ ? step_list_n_ : n_));  // VB_STEP_N
   }
   if (lanes_) make_lane_args();
   if (heun) {
@@ -442,15 +454,28 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
   // triangle contact (its own pass) or folded projections (another way to fewer launches).
   persistent_ = plan_persistent_step(cl.info, heun_steps && !tri_contact_ && !folded, el.hyperelastic, n_,
                                      force_split_, kSplitMaxElements);
+  // The stepping kernels over a list of the free elements (kernels/common.cl, VB_STEP_LIST), on
+  // GPUs where at least a quarter of the elements are held: those then cost no work-item and no
+  // copy of their state per step (the 1.5M phantom, two thirds held: +10% on the H200; a cube on
+  // its held base layer: no change; PERF_NOTES.md change 23). Not with the lanes kernels (their own
+  // list), the split force pass or the one-launch step (their own layouts).
+  // VOXBREAST_STEP_LIST=0|1 overrides the device rule, not the others.
+  const bool list_allowed = !lanes_ && force_split_ == 1 && !persistent_.on;
+  step_list_ = list_allowed && cl.info.is_gpu && 4 * el.held_count >= n_;
+  if (const char* env = std::getenv("VOXBREAST_STEP_LIST")) step_list_ = list_allowed && std::atoi(env) != 0;
   // Linear springs on GPUs: elements whose neighbours share their E and mass take a short
   // connection loop (kernels/lattice_forces.cl, lattice_force_uniform; PERF_NOTES.md change 22),
-  // marked by a negative E. Not in the one-launch step, whose register cap the second loop
-  // overflows (36k cube 72.9k → 47.9k steps/s on the H200), nor with the lanes kernels (they would
-  // need it without a branch, which saves nothing on a CPU). VOXBREAST_UNIFORM_PATH=0|1 overrides
-  // the device rule, not the others.
-  const bool uniform_allowed = !el.hyperelastic && !el.biphasic && !rest_offsets_ && !lanes_ && !persistent_.on;
+  // marked by a negative E in whole warps (uniform_neighbourhood.hpp). Not in the one-launch step,
+  // whose register cap the second loop overflows (36k cube 72.9k → 47.9k steps/s on the H200), nor
+  // with the lanes kernels (they would need it without a branch, which saves nothing on a CPU), nor
+  // with the step list (the H200 ran both together 11% slower than the short loop alone on the
+  // 1.5M cube, and 4% slower than the list alone on the phantom). VOXBREAST_UNIFORM_PATH=0|1
+  // overrides the device rule, not the others.
+  const bool uniform_allowed =
+      !el.hyperelastic && !el.biphasic && !rest_offsets_ && !lanes_ && !persistent_.on && !step_list_;
   uniform_path_ = uniform_allowed && cl.info.is_gpu;
   if (const char* env = std::getenv("VOXBREAST_UNIFORM_PATH")) uniform_path_ = uniform_allowed && std::atoi(env) != 0;
+  uniform_lockstep_ = cl.info.simd_width;
   // Heun's predicted stage under the last correction's pressure instead of a projection of its
   // own (docs/PHYSICS.md, "Volume preservation"): one launch fewer per step on CPUs, two on GPUs.
   // Projected as before when the scene asks, between corrections (every > 1: no multiplier to
@@ -471,9 +496,7 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
 
 void Simulator::make_lane_args() {
   // The lanes kernels step the free elements only (kernels/integrate_lanes.cl), in ascending order.
-  std::vector<cl_uint> free_list;
-  for (std::size_t e = 0; e < n_; ++e)
-    if (inverse_mass_[e] != 0) free_list.push_back(cl_uint(e));
+  std::vector<cl_uint> free_list = free_elements(inverse_mass_);
   const std::size_t n_free = free_list.size();
   if (free_list.empty()) free_list.push_back(0);  // a placeholder: OpenCL has no empty buffers
   free_list_ = cl::Buffer(cl_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, free_list.size() * sizeof(cl_uint),
@@ -767,7 +790,8 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
   for (const auto& row : el.material_table) table.insert(table.end(), row.begin(), row.end());
   if (!per_tissue) table.assign(12, 0.0);
   const std::vector<double> marked_E =
-      uniform_path_ ? mark_uniform_neighbourhoods(lattice_, el.youngs_modulus_pa, inverse_mass_) : el.youngs_modulus_pa;
+      uniform_path_ ? mark_uniform_neighbourhoods(lattice_, el.youngs_modulus_pa, inverse_mass_, uniform_lockstep_)
+                    : el.youngs_modulus_pa;
   uniform_elements_ = std::size_t(std::count_if(marked_E.begin(), marked_E.end(), [](double E) { return E < 0; }));
   const std::vector<unsigned char> E = real_bytes(marked_E);
   const std::vector<unsigned char> materials = real_bytes(table);
@@ -790,6 +814,10 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
   stress_list_n_ = list.size() < n_ ? list.size() : 0;
   const std::size_t list_slot = stress_list_n_ ? arena_.add(list.data(), list.size() * sizeof(cl_uint)) : 0;
   device_bytes_ += stress_list_n_ * sizeof(cl_uint);
+  const std::vector<cl_uint> step_list = step_list_ ? free_elements(inverse_mass_) : std::vector<cl_uint>{};
+  step_list_n_ = step_list.size();
+  const std::size_t step_list_slot = step_list_ ? arena_.add(step_list.data(), std::max<std::size_t>(1, step_list_n_) * sizeof(cl_uint)) : 0;
+  device_bytes_ += step_list_n_ * sizeof(cl_uint);
   require(arena_.bytes() <= cl_.info.max_allocation_bytes,
           "the model's arrays need one buffer of " + mib(double(arena_.bytes())) + " but '" + cl_.info.name +
               "' allocates at most " + mib(double(cl_.info.max_allocation_bytes)),
@@ -802,6 +830,7 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
     arena_at_pred_.s[6] = arena_.offset_units(pred_c);
   }
   stress_list_at_ = stress_list_n_ ? arena_.offset_units(list_slot) : 0;
+  step_list_at_ = step_list_ ? arena_.offset_units(step_list_slot) : 0;
   E_ = arena_.part(slot[0]);
   cell_ = arena_.part(slot[1]);
   rest_offset_ = arena_.part(slot[7]);
@@ -1237,7 +1266,7 @@ void Simulator::upload(const std::vector<double>& u, const std::vector<double>& 
     write_xyz<float>(u_, u, &inverse_mass_);
     write_xyz<float>(v_, v, nullptr);
   }
-  if (lanes_) mirror_state();
+  if (lanes_ || step_list_) mirror_state();
 }
 
 void Simulator::mirror_state() {

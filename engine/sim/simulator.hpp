@@ -163,6 +163,8 @@ class Simulator {
   /// and how many do (engine/sim/uniform_neighbourhood.hpp).
   bool uniform_path() const { return uniform_path_; }
   std::size_t uniform_elements() const { return uniform_elements_; }
+  /// Whether the stepping kernels run over a list of the free elements (GPUs; kernels/integrate.cl).
+  bool step_list() const { return step_list_; }
   /// The volume constraint's scalars as the last kernel left them (kernels/volume.cl; lattice
   /// frame): the last correction's λ (m³ per unit w|g|²) and μ, the last sums' volume V (m³) and
   /// pressure p (Pa, computed by check()), and the lagged multiplier M (Pa·s: M/dt is the pressure
@@ -323,9 +325,13 @@ class Simulator {
   bool lanes_ = false;  ///< the stepping kernels of kernels/integrate_lanes.cl (VB_LANES)
   /// the lanes kernels' arguments: the free elements' list (free_list_), their count, `one`
   void make_lane_args();
-  /// copies (u, v) into the scratch pair (u_tmp_, v_tmp_): the lanes kernels never write held
-  /// elements, so both pairs must hold them (upload, make_lane_args)
+  /// copies (u, v) into the scratch pair (u_tmp_, v_tmp_): the lanes kernels and the listed step
+  /// (step_list_) never write held elements, so both pairs must hold them (upload, make_lane_args)
   void mirror_state();
+  bool step_list_ = false;           ///< the stepping kernels over the free elements' list (VB_STEP_LIST)
+  std::size_t step_list_n_ = 0;      ///< free elements in it
+  cl_uint step_list_at_ = 0;         ///< its offset in the model arena (units; compiled in)
+
   cl::Buffer free_list_;
   cl::NDRange step_global_, step_local_;  ///< the stepping kernels (Heun's VB_SPLIT; lanes: the free elements)
   cl::Buffer vol_grad_pred_, vol_scalars_pred_, vol_no_scalars_;
@@ -340,6 +346,7 @@ class Simulator {
   bool volume_lag_ = false;  ///< Heun's predicted stage (relaxation's step) under the lagged pressure
   bool uniform_path_ = false;  ///< linear springs: uniform neighbourhoods marked, their short loop compiled in
   std::size_t uniform_elements_ = 0;  ///< elements marked
+  std::size_t uniform_lockstep_ = 1;  ///< marked in aligned blocks of this many (the device's simd_width)
   DeviceArena vol_mesh_;  ///< triangles, surface elements, incident start, incident (kernels/volume.cl)
   cl_uint4 vol_mesh_at_{};
   cl::Buffer vol_grad_, vol_partial_,

@@ -10,7 +10,13 @@ namespace vb {
 /// E (Pa) per element with the sign of a free element e negative where every present neighbour j
 /// has E_j = E_e and inverse mass w_j = w_e: there a connection's k = κ_d·h·E_e and its dashpot
 /// 2ζ·√(k·m_e/2) depend on its direction alone.
+/// `lockstep`: elements are marked in whole aligned blocks of that many consecutive indices, all
+/// free elements of a block or none (held ones never: they skip the force loop). A GPU steps
+/// consecutive elements in groups of work-items that execute together (the device's simd_width),
+/// and a group that holds both kinds runs both loops: on the 1.5M phantom, where tissue
+/// interfaces are everywhere, marking element by element made the step 31% slower (PERF_NOTES.md
+/// change 23).
 std::vector<double> mark_uniform_neighbourhoods(const Lattice& lattice, const std::vector<double>& E,
-                                                const std::vector<double>& inverse_mass);
+                                                const std::vector<double>& inverse_mass, std::size_t lockstep = 1);
 
 }  // namespace vb

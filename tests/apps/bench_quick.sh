@@ -10,18 +10,26 @@ trap 'rm -rf "$work"' EXIT
 /usr/bin/python3 "$root/tests/apps/check_bench.py" "$work"
 
 # Throughput of the breast phantom at ~36k elements (--breast), with and without the volume
-# constraint: rows present, the model's size, finite positive rates.
-"$bin" bench --quick --no-study --breast --volume --sizes 8 --laws linear --out "$work/throughput" \
+# constraint, and at ~1.5M (--breast-large): rows present, the models' sizes, finite positive
+# rates, and bandwidth counted over the free elements (the rigid chest wall is not stepped).
+"$bin" bench --quick --no-study --breast --breast-large --volume --sizes 8 --laws linear --out "$work/throughput" \
   --phantom "$root/data-samples/phantom/scene.toml"
 /usr/bin/python3 - "$work/throughput/throughput.csv" <<'PY'
 import csv, math, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 breast = {r["model"]: r for r in rows if r["model"].startswith("breast")}
-assert set(breast) == {"breast", "breast_volume"}, breast.keys()
-for r in breast.values():
-    assert r["elements"] == "34961", r  # the phantom resampled at 3.2 mm
+assert set(breast) == {"breast", "breast_volume", "breast_large"}, breast.keys()
+sizes = {"breast": "34961", "breast_volume": "34961", "breast_large": "1506211"}  # 3.2 mm, 0.92 mm
+for m, r in breast.items():
+    assert r["elements"] == sizes[m], r
     rate = float(r["steps_per_s"])
     assert math.isfinite(rate) and rate > 0, r
+    free = int(r["free_elements"])
+    assert 0 < free < int(r["elements"]), r
+    moved = float(r["bytes_per_element_step"]) * free * rate / 1e9
+    assert abs(float(r["effective_bandwidth_gb_s"]) - moved) <= 1e-3 * moved, r
+block = next(r for r in rows if r["model"] == "block")
+assert int(block["free_elements"]) == 8**3 - 8**2, block  # the cube's base layer is held
 print("breast throughput rows:", {m: round(float(r["steps_per_s"]), 1) for m, r in breast.items()})
 PY
 # On PoCL every row here (float, linear springs, no contact) steps with the kernels CPUs vectorise
