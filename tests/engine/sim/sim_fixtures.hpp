@@ -63,6 +63,34 @@ inline AnchorSpec halfspace_anchor(const std::string& name, const Vec3& point, c
   return a;
 }
 
+/// A 9×9×10 block of soft tissue (E = 3 kPa, h = 4 mm) with a stiff inclusion (another E), a heavy
+/// layer (the same E, another density: another mass) and a held base layer, under oblique gravity,
+/// in double, with dashpots except for relaxation (its own damping): every kind of neighbour a
+/// stepping kernel can meet (UniformPath, StepList).
+inline Scene mixed_block(Integrator integrator, bool volume) {
+  Scene s = box_scene(9, 9, 10, 0.004, 3000);
+  ShapeSpec inclusion;
+  inclusion.kind = ShapeSpec::Kind::Sphere;
+  inclusion.center_m = Vec3(0.018, 0.018, 0.024);
+  inclusion.radius_m = 0.008;
+  inclusion.label = "stiff";
+  s.model.shapes.push_back(inclusion);
+  s.materials["stiff"] = material("stiff", 9000, 1000);
+  ShapeSpec layer = s.model.shapes[0];
+  layer.min_m.z() = 0.032;
+  layer.label = "heavy";
+  s.model.shapes.push_back(layer);
+  s.materials["heavy"] = material("heavy", 3000, 1400);
+  s.anchors.push_back(halfspace_anchor("base", Vec3(0, 0, 0.002), Vec3(0, 0, -1)));
+  s.gravity.active = true;
+  s.gravity.acceleration_m_s2 = Vec3(9.81, 0, -9.81);
+  s.solver.precision = Precision::Double;
+  s.solver.integrator = integrator;
+  s.solver.dashpot_ratio = integrator == Integrator::Relaxation ? 0 : 0.1;
+  s.volume.preserve = volume;
+  return s;
+}
+
 /// The hyperelastic validation tissues: neo-Hookean (E = 3 kPa) or, for law "ogden", two-term
 /// Ogden (μ = 1200, −300 Pa; α = 4, −2); named "soft", ρ = 1000 kg/m³.
 inline MaterialSpec validation_material(const std::string& law, double nu) {

@@ -62,33 +62,6 @@ TEST(UniformNeighbourhood, MarksElementsWhoseNeighboursShareModulusAndMass) {
   EXPECT_LT(grouped_count, count);  // blocks that mix the two kinds lose their marks
 }
 
-// A block of soft tissue with a stiff inclusion (another E), a heavy layer (the same E, another
-// density: another mass) and a held base, under gravity with dashpots: elements next to each of
-// them must keep the general loop, the rest may take the short one.
-Scene mixed_block(Integrator integrator, bool volume) {
-  Scene s = test::box_scene(9, 9, 10, 0.004, 3000);
-  ShapeSpec inclusion;
-  inclusion.kind = ShapeSpec::Kind::Sphere;
-  inclusion.center_m = Vec3(0.018, 0.018, 0.024);
-  inclusion.radius_m = 0.008;
-  inclusion.label = "stiff";
-  s.model.shapes.push_back(inclusion);
-  s.materials["stiff"] = test::material("stiff", 9000, 1000);
-  ShapeSpec layer = s.model.shapes[0];
-  layer.min_m.z() = 0.032;
-  layer.label = "heavy";
-  s.model.shapes.push_back(layer);
-  s.materials["heavy"] = test::material("heavy", 3000, 1400);
-  s.anchors.push_back(test::halfspace_anchor("base", Vec3(0, 0, 0.002), Vec3(0, 0, -1)));
-  s.gravity.active = true;
-  s.gravity.acceleration_m_s2 = Vec3(9.81, 0, -9.81);
-  s.solver.precision = Precision::Double;
-  s.solver.integrator = integrator;
-  s.solver.dashpot_ratio = integrator == Integrator::Relaxation ? 0 : 0.1;
-  s.volume.preserve = volume;
-  return s;
-}
-
 /// u then v after 300 steps from rest (checks every 100: relaxation sets its damping there).
 std::vector<double> run(const Scene& s, bool uniform) {
   const test::Model m = test::make_model(s);
@@ -122,7 +95,7 @@ std::vector<double> run(const Scene& s, bool uniform) {
 TEST(UniformPath, MatchesTheGeneralLoop) {
   for (const Integrator integrator : {Integrator::Heun, Integrator::SymplecticEuler, Integrator::Relaxation})
     for (const bool volume : {false, true}) {
-      const Scene s = mixed_block(integrator, volume);
+      const Scene s = test::mixed_block(integrator, volume);
       const double d = test::relative_difference(run(s, true), run(s, false));
       std::cout << "integrator " << int(integrator) << (volume ? ", volume" : "") << ": short vs general loop " << d << "\n";
       EXPECT_LE(d, 1e-11);
