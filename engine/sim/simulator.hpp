@@ -331,9 +331,9 @@ class Simulator {
   bool step_list_ = false;           ///< the stepping kernels over the free elements' list (VB_STEP_LIST)
   std::size_t step_list_n_ = 0;      ///< free elements in it
   cl_uint step_list_at_ = 0;         ///< its offset in the model arena (units; compiled in)
-
   cl::Buffer free_list_;
-  cl::NDRange step_global_, step_local_;  ///< the stepping kernels (Heun's VB_SPLIT; lanes: the free elements)
+  /// the stepping kernels (Heun's VB_SPLIT; lanes and the step list: the free elements)
+  cl::NDRange step_global_, step_local_;
   cl::Buffer vol_grad_pred_, vol_scalars_pred_, vol_no_scalars_;
   cl::Kernel vol_pending_;
   bool volume_ = false;
