@@ -467,13 +467,12 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
   // connection loop (kernels/lattice_forces.cl, lattice_force_uniform; PERF_NOTES.md change 22),
   // marked by a negative E in whole warps (uniform_neighbourhood.hpp). Not in the one-launch step,
   // whose register cap the second loop overflows (36k cube 72.9k → 47.9k steps/s on the H200), nor
-  // with the lanes kernels (they would need it without a branch, which saves nothing on a CPU), nor
-  // with the step list (the H200 ran both together 11% slower than the short loop alone on the
-  // 1.5M cube, and 4% slower than the list alone on the phantom). VOXBREAST_UNIFORM_PATH=0|1
+  // with the lanes kernels (they would need it without a branch, which saves nothing on a CPU). Off
+  // by default with the step list (the H200 ran both together 11% slower than the short loop alone
+  // on the 1.5M cube, and 4% slower than the list alone on the phantom). VOXBREAST_UNIFORM_PATH=0|1
   // overrides the device rule, not the others.
-  const bool uniform_allowed =
-      !el.hyperelastic && !el.biphasic && !rest_offsets_ && !lanes_ && !persistent_.on && !step_list_;
-  uniform_path_ = uniform_allowed && cl.info.is_gpu;
+  const bool uniform_allowed = !el.hyperelastic && !el.biphasic && !rest_offsets_ && !lanes_ && !persistent_.on;
+  uniform_path_ = uniform_allowed && cl.info.is_gpu && !step_list_;
   if (const char* env = std::getenv("VOXBREAST_UNIFORM_PATH")) uniform_path_ = uniform_allowed && std::atoi(env) != 0;
   uniform_lockstep_ = cl.info.simd_width;
   // Heun's predicted stage under the last correction's pressure instead of a projection of its
