@@ -20,7 +20,7 @@ namespace {
 std::vector<double> run(const Scene& s, bool listed) {
   const test::Model m = test::make_model(s);
   setenv("VOXBREAST_STEP_LIST", listed ? "1" : "0", 1);
-  // the same connection loop in both (GPUs: the short loop is never used with the list)
+  // the same connection loop in both (GPUs: the short loop is off by default with the list)
   setenv("VOXBREAST_UNIFORM_PATH", "0", 1);
   setenv("VOXBREAST_LANES", "0", 1);       // CPUs: the real4 kernels, which the list is for
   setenv("VOXBREAST_PERSISTENT", "0", 1);  // GPUs: nor is the one-launch step listed
