@@ -455,13 +455,15 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
   persistent_ = plan_persistent_step(cl.info, heun_steps && !tri_contact_ && !folded, el.hyperelastic, n_,
                                      force_split_, kSplitMaxElements);
   // The stepping kernels over a list of the free elements (kernels/common.cl, VB_STEP_LIST), on
-  // GPUs where at least a quarter of the elements are held: those then cost no work-item and no
-  // copy of their state per step (the 1.5M phantom, two thirds held: +10% on the H200; a cube on
-  // its held base layer: no change; PERF_NOTES.md change 23). Not with the lanes kernels (their own
-  // list), the split force pass or the one-launch step (their own layouts).
+  // GPUs for models above 262,144 elements of which at least a quarter are held: those then cost
+  // no work-item and no copy of their state per step (the 1.5M phantom, two thirds held: +10% on
+  // the H200; a cube on its held base layer: no change). Smaller models are bound by each pass's
+  // chain of dependent loads, which the list lengthens: the 18k phantom's and the column's
+  // relaxation and Euler runs lost up to 18% (PERF_NOTES.md change 23). Not with the lanes kernels
+  // (their own list), the split force pass or the one-launch step (their own layouts).
   // VOXBREAST_STEP_LIST=0|1 overrides the device rule, not the others.
   const bool list_allowed = !lanes_ && force_split_ == 1 && !persistent_.on;
-  step_list_ = list_allowed && cl.info.is_gpu && 4 * el.held_count >= n_;
+  step_list_ = list_allowed && cl.info.is_gpu && n_ > kSplitMaxElements && 4 * el.held_count >= n_;
   if (const char* env = std::getenv("VOXBREAST_STEP_LIST")) step_list_ = list_allowed && std::atoi(env) != 0;
   // Linear springs on GPUs: elements whose neighbours share their E and mass take a short
   // connection loop (kernels/lattice_forces.cl, lattice_force_uniform; PERF_NOTES.md change 22),
