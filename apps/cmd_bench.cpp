@@ -152,7 +152,8 @@ int run_bench(BenchOptions o) {
         o.volume_predictor == "projection" ? VolumeSpec::Predictor::Projection : VolumeSpec::Predictor::Pressure;
     t.profile = o.profile;
     if (o.breast || o.breast_large) {
-      require(!o.phantom.empty(), "--breast needs the phantom's scene", "bench --breast", "give --phantom");
+      require(!o.phantom.empty(), "--breast and --breast-large need the phantom's scene", "bench --breast",
+              "give --phantom");
       t.phantom_scene = o.phantom;
       t.breast = o.breast;
       t.breast_large = o.breast_large;

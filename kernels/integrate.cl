@@ -175,8 +175,8 @@ kernel void euler_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENT
                        uint n VB_TRI_PARAMS VB_STATE_PARAM) {
   VB_UNPACK_LATTICE;
   VB_UNPACK_STEP_STATE(const, );
-  explicit_stage(VB_STEP_INDEX(get_global_id(0)), u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, VB_STEP_N, 1, VB_NO_PENDING,
-                 VB_NO_LAG VB_TRI_ARGS);
+  explicit_stage(VB_STEP_INDEX(get_global_id(0)), u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt,
+                 VB_STEP_N, 1, VB_NO_PENDING, VB_NO_LAG VB_TRI_ARGS);
 }
 
 // With VB_VOLUME_FOLD (Heun with the volume constraint, kernels/volume.cl: volume_pending) the

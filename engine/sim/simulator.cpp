@@ -476,7 +476,6 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
   const bool uniform_allowed = !el.hyperelastic && !el.biphasic && !rest_offsets_ && !lanes_ && !persistent_.on;
   uniform_path_ = uniform_allowed && cl.info.is_gpu && !step_list_;
   if (const char* env = std::getenv("VOXBREAST_UNIFORM_PATH")) uniform_path_ = uniform_allowed && std::atoi(env) != 0;
-  uniform_lockstep_ = cl.info.simd_width;
   // Heun's predicted stage under the last correction's pressure instead of a projection of its
   // own (docs/PHYSICS.md, "Volume preservation"): one launch fewer per step on CPUs, two on GPUs.
   // Projected as before when the scene asks, between corrections (every > 1: no multiplier to
@@ -791,7 +790,7 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
   for (const auto& row : el.material_table) table.insert(table.end(), row.begin(), row.end());
   if (!per_tissue) table.assign(12, 0.0);
   const std::vector<double> marked_E =
-      uniform_path_ ? mark_uniform_neighbourhoods(lattice_, el.youngs_modulus_pa, inverse_mass_, uniform_lockstep_)
+      uniform_path_ ? mark_uniform_neighbourhoods(lattice_, el.youngs_modulus_pa, inverse_mass_, cl_.info.simd_width)
                     : el.youngs_modulus_pa;
   uniform_elements_ = std::size_t(std::count_if(marked_E.begin(), marked_E.end(), [](double E) { return E < 0; }));
   const std::vector<unsigned char> E = real_bytes(marked_E);

@@ -346,7 +346,6 @@ class Simulator {
   bool volume_lag_ = false;  ///< Heun's predicted stage (relaxation's step) under the lagged pressure
   bool uniform_path_ = false;  ///< linear springs: uniform neighbourhoods marked, their short loop compiled in
   std::size_t uniform_elements_ = 0;  ///< elements marked
-  std::size_t uniform_lockstep_ = 1;  ///< marked in aligned blocks of this many (the device's simd_width)
   DeviceArena vol_mesh_;  ///< triangles, surface elements, incident start, incident (kernels/volume.cl)
   cl_uint4 vol_mesh_at_{};
   cl::Buffer vol_grad_, vol_partial_,

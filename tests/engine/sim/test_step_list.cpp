@@ -5,7 +5,7 @@
 // the held elements (their copy in the predicted-stage arrays is the host's to keep).
 #include <gtest/gtest.h>
 
-#include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -19,14 +19,15 @@ namespace {
 /// 100 (as a moved anchor would be).
 std::vector<double> run(const Scene& s, bool listed) {
   const test::Model m = test::make_model(s);
-  setenv("VOXBREAST_STEP_LIST", listed ? "1" : "0", 1);
-  // the same connection loop in both (GPUs: the short loop is off by default with the list)
-  setenv("VOXBREAST_UNIFORM_PATH", "0", 1);
-  setenv("VOXBREAST_LANES", "0", 1);       // CPUs: the real4 kernels, which the list is for
-  setenv("VOXBREAST_PERSISTENT", "0", 1);  // GPUs: nor is the one-launch step listed
-  Simulator sim(s, m.lattice, m.elements, test::cl_context());
-  for (const char* name : {"VOXBREAST_STEP_LIST", "VOXBREAST_UNIFORM_PATH", "VOXBREAST_LANES", "VOXBREAST_PERSISTENT"})
-    unsetenv(name);
+  const std::unique_ptr<Simulator> made = [&] {
+    const test::ScopedEnv list("VOXBREAST_STEP_LIST", listed ? "1" : "0");
+    // the same connection loop in both (GPUs: the short loop is off by default with the list)
+    const test::ScopedEnv path("VOXBREAST_UNIFORM_PATH", "0");
+    const test::ScopedEnv lanes("VOXBREAST_LANES", "0");            // CPUs: the real4 kernels, which the list is for
+    const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");  // GPUs: nor is the one-launch step listed
+    return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
+  }();
+  Simulator& sim = *made;
   EXPECT_EQ(sim.step_list(), listed);
   sim.advance(100);
   std::vector<double> u, v;

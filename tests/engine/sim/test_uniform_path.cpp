@@ -65,11 +65,12 @@ TEST(UniformNeighbourhood, MarksElementsWhoseNeighboursShareModulusAndMass) {
 /// u then v after 300 steps from rest (checks every 100: relaxation sets its damping there).
 std::vector<double> run(const Scene& s, bool uniform) {
   const test::Model m = test::make_model(s);
-  setenv("VOXBREAST_UNIFORM_PATH", uniform ? "1" : "0", 1);
-  setenv("VOXBREAST_PERSISTENT", "0", 1);  // on GPUs: the short loop is not used in the one-launch step
-  Simulator sim(s, m.lattice, m.elements, test::cl_context());
-  unsetenv("VOXBREAST_UNIFORM_PATH");
-  unsetenv("VOXBREAST_PERSISTENT");
+  const std::unique_ptr<Simulator> made = [&] {
+    const test::ScopedEnv path("VOXBREAST_UNIFORM_PATH", uniform ? "1" : "0");
+    const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");  // GPUs: no short loop in the one-launch step
+    return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
+  }();
+  Simulator& sim = *made;
   EXPECT_EQ(sim.uniform_path(), uniform);
   // Enough elements on each loop for the comparison to mean something: marked one by one (CPUs)
   // most of the block's free elements, not those next to the inclusion, the heavy layer or the
