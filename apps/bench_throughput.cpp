@@ -19,7 +19,7 @@ namespace {
 
 struct BenchCase {
   std::string name;
-  int edge = 0;
+  int edge = 0;  ///< the cube's edge; 0 the breast, −k the k-th --breast-elements model
   Integrator integrator = Integrator::Heun;
   Precision precision = Precision::Float;
   std::string law = "linear";
@@ -275,6 +275,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
   std::vector<BenchCase> cases;
   // the phantom's scenes as it runs them, each law applied per case (cases with edge 0)
   std::optional<bench::BenchScene> breast, breast_large;
+  std::vector<bench::BenchScene> resampled;  // --breast-elements, in the order given
   if (o.breast) {
     breast = bench::image_scene("breast", o.phantom_scene, kBreastSpacing);
     for (const std::string& law : o.laws) {
@@ -285,6 +286,16 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
   if (o.breast_large) {
     breast_large = bench::image_scene("breast_large", o.phantom_scene, bench::kLargePhantomSpacing);
     cases.push_back({"breast_large", 0, Integrator::Heun, Precision::Float, "linear"});
+  }
+  if (!o.breast_elements.empty()) {
+    // the spacing that gives about N elements: the phantom's own spacing × (own count / N)^(1/3)
+    const bench::BenchScene own = bench::image_scene("breast_resampled", o.phantom_scene, 0);
+    const double own_count = double(build_lattice(own.volume).element_count());
+    for (long target : o.breast_elements) {
+      const double spacing = own.scene.model.spacing_m * std::cbrt(own_count / double(target));
+      resampled.push_back(bench::image_scene("breast_resampled", o.phantom_scene, spacing));
+      cases.push_back({"breast_resampled", -int(resampled.size()), Integrator::Heun, Precision::Float, "linear"});
+    }
   }
   for (int edge : sizes) {
     cases.push_back({"block", edge, Integrator::Heun, Precision::Float});
@@ -305,8 +316,10 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
   for (const BenchCase& c : cases) {
     Scene scene;
     Lattice lattice;
-    if (c.edge == 0) {  // the breast: its tissues (muscle rigid) on the case's law, Heun, float
-      const bench::BenchScene& breast_case = c.name == "breast_large" ? *breast_large : *breast;
+    if (c.edge <= 0) {  // the breast: its tissues (muscle rigid) on the case's law, Heun, float
+      const bench::BenchScene& breast_case = c.edge < 0                ? resampled[std::size_t(-c.edge - 1)]
+                                             : c.name == "breast_large" ? *breast_large
+                                                                        : *breast;
       scene = breast_case.scene;
       bench::apply_law(scene, c.law);
       scene.solver.integrator = c.integrator;

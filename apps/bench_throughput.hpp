@@ -21,6 +21,9 @@ struct ThroughputOptions {
   /// also time the phantom resampled to ~36k elements (models "breast", "breast_volume"), every law
   bool breast = false;
   bool breast_large = false;  ///< also time it at ~1.5M elements (model "breast_large"), linear springs
+  /// also time it resampled to about each of these element counts (model "breast_resampled"),
+  /// linear springs: the phantom's rate against size (where the step list pays, change 23)
+  std::vector<long> breast_elements;
 };
 
 struct ThroughputResult {

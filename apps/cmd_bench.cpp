@@ -38,6 +38,7 @@ struct BenchOptions {
   std::string volume_predictor = "pressure";  ///< throughput: [volume] predictor of the volume cases
   bool breast = false;        ///< throughput: the phantom at ~36k elements too
   bool breast_large = false;  ///< throughput: the phantom at ~1.5M elements too
+  std::vector<long> breast_elements;  ///< throughput: the phantom resampled to about these counts
   std::vector<int> sizes;  ///< throughput blocks (edge lengths in elements)
   std::vector<int> haptic_elements = {10000};  ///< haptic-rate blocks (about this many elements)
   double haptic_seconds = 3;
@@ -141,22 +142,24 @@ int run_bench(BenchOptions o) {
     doc["haptic"] = run_haptic_bench(*cl, o);
     write_outputs();
   }
-  if (!o.dry_run && (!o.sizes.empty() || o.breast || o.breast_large || (!o.quick && o.no_study && !o.haptic))) {
+  const bool breast_any = o.breast || o.breast_large || !o.breast_elements.empty();
+  if (!o.dry_run && (!o.sizes.empty() || breast_any || (!o.quick && o.no_study && !o.haptic))) {
     if (!cl) cl = std::make_unique<ClContext>(device);
     ThroughputOptions t;
     // 35,937 and 1,520,875 elements unless sizes are given; --breast alone times the breast alone
-    t.sizes = !o.sizes.empty() || o.breast || o.breast_large ? o.sizes : std::vector<int>{33, 115};
+    t.sizes = !o.sizes.empty() || breast_any ? o.sizes : std::vector<int>{33, 115};
     t.quick = o.quick;
     t.volume = o.volume;
     t.volume_predictor =
         o.volume_predictor == "projection" ? VolumeSpec::Predictor::Projection : VolumeSpec::Predictor::Pressure;
     t.profile = o.profile;
-    if (o.breast || o.breast_large) {
-      require(!o.phantom.empty(), "--breast and --breast-large need the phantom's scene", "bench --breast",
-              "give --phantom");
+    if (breast_any) {
+      require(!o.phantom.empty(), "--breast, --breast-large and --breast-elements need the phantom's scene",
+              "bench --breast", "give --phantom");
       t.phantom_scene = o.phantom;
       t.breast = o.breast;
       t.breast_large = o.breast_large;
+      t.breast_elements = o.breast_elements;
     }
     if (!o.laws.empty()) t.laws = o.laws;
     const ThroughputResult tr = run_throughput(*cl, t);
@@ -233,6 +236,10 @@ Command add_bench(CLI::App& app) {
                 "throughput: also time the breast phantom resampled to ~36k elements (models breast, breast_volume)");
   sub->add_flag("--breast-large", o->breast_large,
                 "throughput: also time the breast phantom resampled to ~1.5M elements, linear springs (model breast_large)");
+  sub->add_option("--breast-elements", o->breast_elements,
+                  "throughput: also time the breast phantom resampled to about each of these element counts, "
+                  "linear springs (model breast_resampled)")
+      ->check(CLI::Range(1000L, 100000000L));
   sub->add_flag("--volume", o->volume, "throughput: also time each law with [volume] preserve = true (model block_volume)");
   sub->add_option("--volume-predictor", o->volume_predictor,
                   "throughput: [volume] predictor of the --volume models: pressure (default) or projection, to time "
