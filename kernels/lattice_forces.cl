@@ -25,40 +25,6 @@ inline real spring_end(int law, global const real* mat, real k, real len, real r
 #define spring_end(law, mat, k, len, rest) ((real)0.5 * (k) * ((len) - (rest)))
 #endif
 
-// One connection of element e (at grid cell `cell`) in direction d, as both connection loops
-// below see it: the neighbour j, its u as a pending volume projection leaves it (wgj: what
-// pending_v then needs), and the unit vector n and length of r = h·d + u_j − u_i.
-// Branch-free: a missing neighbour reads the element itself (j = e) with present = 0, and the
-// caller masks it out, so CPU compilers can vectorise across work-items.
-typedef struct {
-  int j;
-  real present, len;
-  real4 uj, wgj, n;
-} vb_connection;
-
-VB_INLINE vb_connection connection_to(uint e, int cell, int d, real4 ui, global const real4* u, global const int* grid,
-                                      int sy, int sz, real h, VB_PENDING_PARAMS) {
-  vb_connection c;
-  const int jn = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
-  c.present = jn >= 0 ? (real)1 : (real)0;
-  c.j = jn >= 0 ? jn : (int)e;
-  c.uj = u[c.j];
-  c.wgj = (real4)(0);
-  pending_u(&c.uj, &c.wgj, (uint)c.j, VB_PENDING_ARGS);
-  const real4 r = (real4)(h * VB_DIR[d][0] + (c.uj.x - ui.x), h * VB_DIR[d][1] + (c.uj.y - ui.y),
-                          h * VB_DIR[d][2] + (c.uj.z - ui.z), 0);
-  const real len_sq = dot3(r, r);
-#if VB_RSQRT
-  const real inv_len_raw = rsqrt(len_sq);  // a hardware instruction on GPUs
-#else
-  const real inv_len_raw = 1 / sqrt(len_sq);  // PoCL's rsqrt() is a slow library call (3× here)
-#endif
-  const real inv_len = len_sq > 0 ? inv_len_raw : (real)0;  // coincident neighbours: no direction, no NaN
-  c.len = len_sq * inv_len;
-  c.n = r * inv_len;
-  return c;
-}
-
 // Linear springs only (no rest offsets): the force on a free element whose present neighbours all
 // have its E and inverse mass w, which the host marks with a negative E (engine/sim/
 // uniform_neighbourhood.hpp). Then E_ij = E, k = κ_d·h·E and the dashpot's 2ζ·√(k/(2w)) =
@@ -77,15 +43,30 @@ VB_INLINE real4 lattice_force_uniform(uint e, real Ei, real4 ui, real4 vi, globa
 #pragma unroll
   for (int d = 0; d < 26; ++d) {
     if (d < d_lo || d >= d_hi) continue;
-    const vb_connection c = connection_to(e, cell, d, ui, u, grid, sy, sz, h, VB_PENDING_ARGS);
-    const real k = c.present * (VB_KAPPA[d] * h * Ei);
-    real magnitude = k * (c.len - h * VB_DIR_LEN[d]);
-#if VB_DASHPOT
-    real4 vj = v[c.j];
-    pending_v(&vj, c.wgj, VB_PENDING_ARGS);
-    magnitude += c.present * (damping_e * VB_SQRT_KAPPA[d]) * dot3(vj - vi, c.n);
+    const int jn = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
+    const real present = jn >= 0 ? (real)1 : (real)0;
+    const int j = jn >= 0 ? jn : (int)e;
+    real4 uj = u[j], wgj = (real4)(0);
+    pending_u(&uj, &wgj, (uint)j, VB_PENDING_ARGS);
+    const real4 r = (real4)(h * VB_DIR[d][0] + (uj.x - ui.x), h * VB_DIR[d][1] + (uj.y - ui.y),
+                            h * VB_DIR[d][2] + (uj.z - ui.z), 0);
+    const real len_sq = dot3(r, r);
+#if VB_RSQRT
+    const real inv_len_raw = rsqrt(len_sq);
+#else
+    const real inv_len_raw = 1 / sqrt(len_sq);
 #endif
-    f += magnitude * c.n;
+    const real inv_len = len_sq > 0 ? inv_len_raw : (real)0;
+    const real len = len_sq * inv_len;
+    const real4 n = r * inv_len;
+    const real k = present * (VB_KAPPA[d] * h * Ei);
+    real magnitude = k * (len - h * VB_DIR_LEN[d]);
+#if VB_DASHPOT
+    real4 vj = v[j];
+    pending_v(&vj, wgj, VB_PENDING_ARGS);
+    magnitude += present * (damping_e * VB_SQRT_KAPPA[d]) * dot3(vj - vi, n);
+#endif
+    f += magnitude * n;
   }
   return f;
 }
@@ -128,11 +109,24 @@ VB_INLINE real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const r
 #pragma unroll
   for (int d = 0; d < 26; ++d) {
     if (d < d_lo || d >= d_hi) continue;  // d is a constant once unrolled; the range is uniform
-    const vb_connection c = connection_to(e, cell, d, ui, u, grid, sy, sz, h, VB_PENDING_ARGS);
-    const int j = c.j;
-    const real present = c.present, len = c.len;
-    const real4 uj = c.uj, n = c.n;
+    // Branch-free: a missing neighbour reads the element itself and is masked out, so CPU
+    // compilers can vectorise across work-items.
+    const int jn = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
+    const real present = jn >= 0 ? (real)1 : (real)0;
+    const int j = jn >= 0 ? jn : (int)e;
+    real4 uj = u[j], wgj = (real4)(0);
+    pending_u(&uj, &wgj, (uint)j, VB_PENDING_ARGS);
     const real4 hd = (real4)(h * VB_DIR[d][0], h * VB_DIR[d][1], h * VB_DIR[d][2], 0);
+    const real4 r = (real4)(hd.x + (uj.x - ui.x), hd.y + (uj.y - ui.y), hd.z + (uj.z - ui.z), 0);
+    const real len_sq = dot3(r, r);
+#if VB_RSQRT
+    const real inv_len_raw = rsqrt(len_sq);  // a hardware instruction on GPUs
+#else
+    const real inv_len_raw = 1 / sqrt(len_sq);  // PoCL's rsqrt() is a slow library call (3× here)
+#endif
+    const real inv_len = len_sq > 0 ? inv_len_raw : (real)0;  // coincident neighbours: no direction, no NaN
+    const real len = len_sq * inv_len;
+    const real4 n = r * inv_len;
 #if VB_UNIFORM_PATH
     const real Ej = fabs(E[j]);  // negative: a uniform neighbourhood (lattice_force_uniform)
 #else
@@ -187,7 +181,7 @@ VB_INLINE real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const r
 #endif
 #if VB_DASHPOT
     real4 vj = v[j];
-    pending_v(&vj, c.wgj, VB_PENDING_ARGS);
+    pending_v(&vj, wgj, VB_PENDING_ARGS);
     magnitude += 2 * dashpot_ratio * sqrt(kE * q) * dot3(vj - vi, n);
 #endif
     f += magnitude * n;
