@@ -70,6 +70,11 @@ Scene block_scene(const BenchCase& c) {
   return s;
 }
 
+/// The integrator's bench knob name (engine/bench/bench_knobs.hpp).
+const char* integrator_label(Integrator i) {
+  return i == Integrator::Heun ? "heun" : i == Integrator::Relaxation ? "relaxation" : "symplectic_euler";
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -294,7 +299,12 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     for (long target : o.breast_elements) {
       const double spacing = own.scene.model.spacing_m * std::cbrt(own_count / double(target));
       resampled.push_back(bench::image_scene("breast_resampled", o.phantom_scene, spacing));
-      cases.push_back({"breast_resampled", -int(resampled.size()), Integrator::Heun, Precision::Float, "linear"});
+      for (const std::string& law : o.laws)
+        for (const std::string& name : o.breast_integrators) {
+          Scene knobs;
+          bench::apply_integrator(knobs, name);
+          cases.push_back({"breast_resampled", -int(resampled.size()), knobs.solver.integrator, Precision::Float, law});
+        }
     }
   }
   for (int edge : sizes) {
@@ -322,7 +332,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                                                                         : *breast;
       scene = breast_case.scene;
       bench::apply_law(scene, c.law);
-      scene.solver.integrator = c.integrator;
+      bench::apply_integrator(scene, integrator_label(c.integrator));
       scene.solver.precision = c.precision;
       scene.volume.preserve = c.volume;
       lattice = build_lattice(breast_case.volume);
@@ -339,10 +349,12 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     // (most of the phantom's rigid chest wall not at all).
     const std::size_t n_free = n - el.held_count;
     const std::size_t real_size = c.precision == Precision::Double ? 8 : 4;
+    // one stage for Euler, and for relaxation with the element's mass scale
     const bool heun = c.integrator == Integrator::Heun;
-    const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, c.law);
+    const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, c.law) +
+                         (c.integrator == Integrator::Relaxation ? double(real_size) : 0.0);
     const double effective = bytes * double(n_free) * sps;
-    const char* integ = heun ? "heun" : "symplectic_euler";
+    const char* integ = integrator_label(c.integrator);
     const char* prec = c.precision == Precision::Double ? "double" : "float";
     std::printf("%-12s %9zu elements (%zu free)  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
                 c.name.c_str(), n, n_free, c.law.c_str(), integ, prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);

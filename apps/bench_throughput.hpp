@@ -22,8 +22,10 @@ struct ThroughputOptions {
   bool breast = false;
   bool breast_large = false;  ///< also time it at ~1.5M elements (model "breast_large"), linear springs
   /// also time it resampled to about each of these element counts (model "breast_resampled"),
-  /// linear springs: the phantom's rate against size (where the step list pays, change 23)
+  /// each law and integrator: the phantom's rate against size (where the step list and the
+  /// one-launch step pay, docs/PERF_NOTES.md changes 23 and 24)
   std::vector<long> breast_elements;
+  std::vector<std::string> breast_integrators{"heun"};  ///< those models' integrators (bench knob names)
 };
 
 struct ThroughputResult {

@@ -160,6 +160,7 @@ int run_bench(BenchOptions o) {
       t.breast = o.breast;
       t.breast_large = o.breast_large;
       t.breast_elements = o.breast_elements;
+      if (!o.integrators.empty()) t.breast_integrators = o.integrators;
     }
     if (!o.laws.empty()) t.laws = o.laws;
     const ThroughputResult tr = run_throughput(*cl, t);
@@ -228,7 +229,7 @@ Command add_bench(CLI::App& app) {
   sub->add_flag("--large", o->large, "add phantom_large (~1.5M elements; on by default on a GPU without --quick)");
   sub->add_option("--laws", o->laws, "material laws of the grid (linear, biphasic, neo-hookean, ogden; default all, --quick all but ogden)")
       ->check(CLI::IsMember(bench::law_names()));
-  sub->add_option("--integrators", o->integrators, "only these integrators")->check(CLI::IsMember(bench::integrator_names()));
+  sub->add_option("--integrators", o->integrators, "only these integrators (the study; and the --breast-elements models, default heun)")->check(CLI::IsMember(bench::integrator_names()));
   sub->add_flag("--no-study", o->no_study, "skip the speed/accuracy study (throughput only)");
   sub->add_option("--sizes", o->sizes, "throughput: time cubes of these edge lengths in elements (e.g. 33 115)")
       ->check(CLI::Range(2, 1000));
@@ -238,7 +239,7 @@ Command add_bench(CLI::App& app) {
                 "throughput: also time the breast phantom resampled to ~1.5M elements, linear springs (model breast_large)");
   sub->add_option("--breast-elements", o->breast_elements,
                   "throughput: also time the breast phantom resampled to about each of these element counts, "
-                  "linear springs (model breast_resampled)")
+                  "each of --laws (default linear) and --integrators (default heun) (model breast_resampled)")
       ->check(CLI::Range(1000L, 100000000L));
   sub->add_flag("--volume", o->volume, "throughput: also time each law with [volume] preserve = true (model block_volume)");
   sub->add_option("--volume-predictor", o->volume_predictor,

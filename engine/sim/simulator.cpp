@@ -32,6 +32,14 @@ constexpr std::size_t kVolumeGpuWorkGroup = 512;
 // VB_SPLIT (kernels/integrate.cl): work-group size of the split Heun kernels, and the model size
 // up to which GPUs split (the perf branch gained at 36k elements and lost nothing to ~100k)
 constexpr std::size_t kSplitWorkGroup = 128, kSplitMaxElements = 262144;
+// Spring models up to this size take Heun's one-launch step on NVIDIA (kernels/persistent.cl):
+// at 36k elements it beat the launched step by 6% (cube and phantom), at 47k it lost 3% (cube),
+// at 64k–216k 26–53% (H200; docs/PERF_NOTES.md change 24).
+constexpr std::size_t kPersistentMaxElements = 40960;
+// GPU models above this size with a quarter or more held step over a list of their free elements
+// (VB_STEP_LIST): from 76k up the phantom gained with every law and integrator but hyperelastic
+// relaxation at 76k (−1 to −2%); at 18k its hyperelastic relaxation lost 10% (change 24).
+constexpr std::size_t kStepListMinElements = 65536;
 constexpr int kCheckBaseSlots = 5, kCheckSlotsPerIndenter = 4;  // kernels/checks.cl
 constexpr int kCheckSlotsPerTorus = 8;                             // VB_TORUS_SLOTS
 constexpr int kIndenterStride = 20;                                // VB_IND_STRIDE
@@ -453,17 +461,17 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
   // Heun's whole step in one launch where the device allows it (kernels/persistent.cl): not with
   // triangle contact (its own pass) or folded projections (another way to fewer launches).
   persistent_ = plan_persistent_step(cl.info, heun_steps && !tri_contact_ && !folded, el.hyperelastic, n_,
-                                     force_split_, kSplitMaxElements);
+                                     force_split_, kPersistentMaxElements);
   // The stepping kernels over a list of the free elements (kernels/common.cl, VB_STEP_LIST), on
-  // GPUs for models above 262,144 elements of which at least a quarter are held: those then cost
-  // no work-item and no copy of their state per step (the 1.5M phantom, two thirds held: +10% on
-  // the H200; a cube on its held base layer: no change). Smaller models are bound by each pass's
-  // chain of dependent loads, which the list lengthens: the 18k phantom's and the column's
-  // relaxation and Euler runs lost up to 18% (PERF_NOTES.md change 23). Not with the lanes kernels
+  // GPUs for models above 65,536 elements of which at least a quarter are held: those then cost
+  // no work-item and no copy of their state per step (the phantom, two thirds held: Heun +10% at
+  // 76k, +16% at 1.5M, up to +38% between; relaxation and Euler +2% to +41%). Smaller models are
+  // bound by each pass's chain of dependent loads, which the list lengthens (the 18k phantom's
+  // hyperelastic relaxation lost 10%; PERF_NOTES.md changes 23, 24). Not with the lanes kernels
   // (their own list), the split force pass or the one-launch step (their own layouts).
   // VOXBREAST_STEP_LIST=0|1 overrides the device rule, not the others.
   const bool list_allowed = !lanes_ && force_split_ == 1 && !persistent_.on;
-  step_list_ = list_allowed && cl.info.is_gpu && n_ > kSplitMaxElements && 4 * el.held_count >= n_;
+  step_list_ = list_allowed && cl.info.is_gpu && n_ > kStepListMinElements && 4 * el.held_count >= n_;
   if (const char* env = std::getenv("VOXBREAST_STEP_LIST")) step_list_ = list_allowed && std::atoi(env) != 0;
   // Linear springs on GPUs: elements whose neighbours share their E and mass take a short
   // connection loop (kernels/lattice_forces.cl, lattice_force_uniform; PERF_NOTES.md change 22),
