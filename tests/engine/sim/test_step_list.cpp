@@ -1,5 +1,5 @@
 // The stepping kernels over a list of the free elements (kernels/common.cl, VB_STEP_LIST; on by
-// default on GPUs for models above 262,144 elements with a quarter or more held;
+// default on GPUs for models above 65,536 elements with a quarter or more held;
 // VOXBREAST_STEP_LIST=1 forces it here) against the same kernels over every element: each
 // element's arithmetic is the same, so the two must agree to the bit, also after the host moves
 // the held elements (their copy in the predicted-stage arrays is the host's to keep).
