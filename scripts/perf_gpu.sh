@@ -9,7 +9,7 @@
 # this build's, so that one call gives an A/B on one device.
 # Switches the A/B rows also try (docs/PERF_NOTES.md, changes 7–9):
 #   VOXBREAST_FORCE_SPLIT=1|2|4      work-items per element in Heun's force passes (GPU default 2
-#                                    for hyperelastic models up to 262,144 elements)
+#                                    for hyperelastic models up to 98,304 elements)
 #   --volume-predictor projection    the volume rows with Heun's predicted stage projected (change 15)
 #   VOXBREAST_STRESS_PAIR=0          both element stresses of a Heun step in two launches (change 16)
 #   VOXBREAST_PERSISTENT=0|1         Heun's step as one launch with grid barriers (NVIDIA default

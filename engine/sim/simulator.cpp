@@ -30,8 +30,9 @@ constexpr int kCheckWorkGroup = 128;
 // to the whole surface, so wide groups keep that tail short
 constexpr std::size_t kVolumeGpuWorkGroup = 512;
 // VB_SPLIT (kernels/integrate.cl): work-group size of the split Heun kernels, and the model size
-// up to which GPUs split (the perf branch gained at 36k elements and lost nothing to ~100k)
-constexpr std::size_t kSplitWorkGroup = 128, kSplitMaxElements = 262144;
+// up to which GPUs split: Ogden on the H200 gained 3–9% at 36k and 76k, lost 4.5% at 125k (cube)
+// and 13.5% at 262k (cube), 6–23% at 147k–246k (phantom; docs/PERF_NOTES.md change 24)
+constexpr std::size_t kSplitWorkGroup = 128, kSplitMaxElements = 98304;
 // Spring models up to this size take Heun's one-launch step on NVIDIA (kernels/persistent.cl):
 // at 36k elements it beat the launched step by 6% (cube and phantom), at 47k it lost 3% (cube),
 // at 64k–216k 26–53% (H200; docs/PERF_NOTES.md change 24).

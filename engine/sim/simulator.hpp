@@ -174,7 +174,7 @@ class Simulator {
   };
   VolumeScalars volume_scalars() const;
   /// work-items per element in Heun's force passes (kernels/integrate.cl, VB_SPLIT): 2 on GPUs for
-  /// hyperelastic models up to 262,144 elements, else 1; VOXBREAST_FORCE_SPLIT=1|2|4 overrides
+  /// hyperelastic models up to 98,304 elements, else 1; VOXBREAST_FORCE_SPLIT=1|2|4 overrides
   int force_split() const { return force_split_; }
   /// every integrator steps with the CPU kernels on scalar components, over the free elements
   /// (kernels/integrate_lanes.cl): CPU devices, plain float spring models; VOXBREAST_LANES=0 turns them off
