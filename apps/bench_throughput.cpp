@@ -278,7 +278,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
   if (o.profile) print_launch_floor(cl);
 
   std::vector<BenchCase> cases;
-  // the phantom's scenes as it runs them, each law applied per case (cases with edge 0)
+  // the phantom's scenes as it runs them, each law and integrator applied per case (edge ≤ 0)
   std::optional<bench::BenchScene> breast, breast_large;
   std::vector<bench::BenchScene> resampled;  // --breast-elements, in the order given
   if (o.breast) {
@@ -326,7 +326,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
   for (const BenchCase& c : cases) {
     Scene scene;
     Lattice lattice;
-    if (c.edge <= 0) {  // the breast: its tissues (muscle rigid) on the case's law, Heun, float
+    if (c.edge <= 0) {  // the breast: its tissues (muscle rigid) on the case's law and integrator, float
       const bench::BenchScene& breast_case = c.edge < 0                ? resampled[std::size_t(-c.edge - 1)]
                                              : c.name == "breast_large" ? *breast_large
                                                                         : *breast;
