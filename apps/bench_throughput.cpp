@@ -19,11 +19,12 @@ namespace {
 
 struct BenchCase {
   std::string name;
-  int edge = 0;  ///< the cube's edge; 0 the breast, −k the k-th --breast-elements model
-  Integrator integrator = Integrator::Heun;
+  int edge = 0;                     ///< the cube's edge (elements), for cube models
+  std::string integrator = "heun";  ///< a bench knob name (engine/bench/bench_knobs.hpp)
   Precision precision = Precision::Float;
   std::string law = "linear";
   bool volume = false;
+  const bench::BenchScene* phantom = nullptr;  ///< the phantom's scene; none: the cube
 };
 
 /// The bundled phantom's spacing for a ~36k-element breast (34,961 elements at 3.2 mm; 18,413 at
@@ -55,7 +56,7 @@ Scene block_scene(const BenchCase& c) {
   }
   m.poisson_ratio = 0.45;
   s.materials["adipose"] = m;
-  s.solver.integrator = c.integrator;
+  bench::apply_integrator(s, c.integrator);
   s.solver.precision = c.precision;
   s.solver.damping_per_s = 5;
   s.gravity.active = true;
@@ -68,11 +69,6 @@ Scene block_scene(const BenchCase& c) {
   s.anchors.push_back(base);
   s.volume.preserve = c.volume;
   return s;
-}
-
-/// The integrator's bench knob name (engine/bench/bench_knobs.hpp).
-const char* integrator_label(Integrator i) {
-  return i == Integrator::Heun ? "heun" : i == Integrator::Relaxation ? "relaxation" : "symplectic_euler";
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -278,20 +274,12 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
   if (o.profile) print_launch_floor(cl);
 
   std::vector<BenchCase> cases;
-  // the phantom's scenes as it runs them, each law and integrator applied per case (edge ≤ 0)
+  // the phantom's scenes as it runs them (each case applies its law and integrator to a copy);
+  // every scene is made before the cases point at them
   std::optional<bench::BenchScene> breast, breast_large;
   std::vector<bench::BenchScene> resampled;  // --breast-elements, in the order given
-  if (o.breast) {
-    breast = bench::image_scene("breast", o.phantom_scene, kBreastSpacing);
-    for (const std::string& law : o.laws) {
-      cases.push_back({"breast", 0, Integrator::Heun, Precision::Float, law});
-      if (o.volume) cases.push_back({"breast_volume", 0, Integrator::Heun, Precision::Float, law, true});
-    }
-  }
-  if (o.breast_large) {
-    breast_large = bench::image_scene("breast_large", o.phantom_scene, bench::kLargePhantomSpacing);
-    cases.push_back({"breast_large", 0, Integrator::Heun, Precision::Float, "linear"});
-  }
+  if (o.breast) breast = bench::image_scene("breast", o.phantom_scene, kBreastSpacing);
+  if (o.breast_large) breast_large = bench::image_scene("breast_large", o.phantom_scene, bench::kLargePhantomSpacing);
   if (!o.breast_elements.empty()) {
     // the spacing that gives about N elements: the phantom's own spacing × (own count / N)^(1/3)
     const bench::BenchScene own = bench::image_scene("breast_resampled", o.phantom_scene, 0);
@@ -299,25 +287,29 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     for (long target : o.breast_elements) {
       const double spacing = own.scene.model.spacing_m * std::cbrt(own_count / double(target));
       resampled.push_back(bench::image_scene("breast_resampled", o.phantom_scene, spacing));
-      for (const std::string& law : o.laws)
-        for (const std::string& name : o.breast_integrators) {
-          Scene knobs;
-          bench::apply_integrator(knobs, name);
-          cases.push_back({"breast_resampled", -int(resampled.size()), knobs.solver.integrator, Precision::Float, law});
-        }
     }
   }
+  if (breast)
+    for (const std::string& law : o.laws) {
+      cases.push_back({"breast", 0, "heun", Precision::Float, law, false, &*breast});
+      if (o.volume) cases.push_back({"breast_volume", 0, "heun", Precision::Float, law, true, &*breast});
+    }
+  if (breast_large) cases.push_back({"breast_large", 0, "heun", Precision::Float, "linear", false, &*breast_large});
+  for (const bench::BenchScene& phantom : resampled)
+    for (const std::string& law : o.laws)
+      for (const std::string& integrator : o.breast_integrators)
+        cases.push_back({"breast_resampled", 0, integrator, Precision::Float, law, false, &phantom});
   for (int edge : sizes) {
-    cases.push_back({"block", edge, Integrator::Heun, Precision::Float});
+    cases.push_back({"block", edge, "heun", Precision::Float});
     if (!o.quick) {
-      cases.push_back({"block", edge, Integrator::SymplecticEuler, Precision::Float});
-      if (cl.info.fp64) cases.push_back({"block", edge, Integrator::Heun, Precision::Double});
+      cases.push_back({"block", edge, "symplectic_euler", Precision::Float});
+      if (cl.info.fp64) cases.push_back({"block", edge, "heun", Precision::Double});
     }
     for (const std::string& law : o.laws)
-      if (law != "linear") cases.push_back({"block", edge, Integrator::Heun, Precision::Float, law});
+      if (law != "linear") cases.push_back({"block", edge, "heun", Precision::Float, law});
     if (o.volume)
       for (const std::string& law : o.laws)
-        cases.push_back({"block_volume", edge, Integrator::Heun, Precision::Float, law, true});
+        cases.push_back({"block_volume", edge, "heun", Precision::Float, law, true});
   }
   nlohmann::json rows = nlohmann::json::array();
   std::ostringstream csv;
@@ -326,16 +318,13 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
   for (const BenchCase& c : cases) {
     Scene scene;
     Lattice lattice;
-    if (c.edge <= 0) {  // the breast: its tissues (muscle rigid) on the case's law and integrator, float
-      const bench::BenchScene& breast_case = c.edge < 0                ? resampled[std::size_t(-c.edge - 1)]
-                                             : c.name == "breast_large" ? *breast_large
-                                                                        : *breast;
-      scene = breast_case.scene;
+    if (c.phantom) {  // the breast: its tissues (muscle rigid) on the case's law and integrator, float
+      scene = c.phantom->scene;
       bench::apply_law(scene, c.law);
-      bench::apply_integrator(scene, integrator_label(c.integrator));
+      bench::apply_integrator(scene, c.integrator);
       scene.solver.precision = c.precision;
       scene.volume.preserve = c.volume;
-      lattice = build_lattice(breast_case.volume);
+      lattice = build_lattice(c.phantom->volume);
     } else {
       scene = block_scene(c);
       lattice = build_lattice(voxelise_shapes(scene));
@@ -350,11 +339,11 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     const std::size_t n_free = n - el.held_count;
     const std::size_t real_size = c.precision == Precision::Double ? 8 : 4;
     // one stage for Euler, and for relaxation with the element's mass scale
-    const bool heun = c.integrator == Integrator::Heun;
+    const bool heun = c.integrator == "heun";
     const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, c.law) +
-                         (c.integrator == Integrator::Relaxation ? double(real_size) : 0.0);
+                         (c.integrator == "relaxation" ? double(real_size) : 0.0);
     const double effective = bytes * double(n_free) * sps;
-    const char* integ = integrator_label(c.integrator);
+    const char* integ = c.integrator.c_str();
     const char* prec = c.precision == Precision::Double ? "double" : "float";
     std::printf("%-12s %9zu elements (%zu free)  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
                 c.name.c_str(), n, n_free, c.law.c_str(), integ, prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
