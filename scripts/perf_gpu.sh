@@ -13,7 +13,7 @@
 #   --volume-predictor projection    the volume rows with Heun's predicted stage projected (change 15)
 #   VOXBREAST_STRESS_PAIR=0          both element stresses of a Heun step in two launches (change 16)
 #   VOXBREAST_PERSISTENT=0|1         Heun's step as one launch with grid barriers (NVIDIA default
-#                                    for spring models up to 40,960 elements; the 36k rows run
+#                                    for spring models up to 45,056 elements; the 36k rows run
 #                                    the default and =0)
 #   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
 #   device: bash scripts/perf_gpu.sh      (run tool, carry [".device-pkgs"]; writes $OUT/perf)

@@ -34,9 +34,9 @@ constexpr std::size_t kVolumeGpuWorkGroup = 512;
 // and 13.5% at 262k (cube), 6–23% at 147k–246k (phantom; docs/PERF_NOTES.md change 24)
 constexpr std::size_t kSplitWorkGroup = 128, kSplitMaxElements = 98304;
 // Spring models up to this size take Heun's one-launch step on NVIDIA (kernels/persistent.cl):
-// at 36k elements it beat the launched step by 6% (cube and phantom), at 47k it lost 3% (cube),
-// at 64k–216k 26–53% (H200; docs/PERF_NOTES.md change 24).
-constexpr std::size_t kPersistentMaxElements = 40960;
+// it beat the launched step by 6% at 36k and 14–17% at 39k and 43k (cubes), lost 3% at 47k (cube)
+// and 26–53% at 64k–216k (H200; docs/PERF_NOTES.md changes 24 and 25).
+constexpr std::size_t kPersistentMaxElements = 45056;
 // GPU models above this size with a quarter or more held step over a list of their free elements
 // (VB_STEP_LIST): from 76k up the phantom gained with every law and integrator but hyperelastic
 // relaxation at 76k (−1 to −2%); at 18k its hyperelastic relaxation lost 10% (change 24).
