@@ -116,7 +116,7 @@ nlohmann::json run_haptic_bench(const ClContext& cl, const BenchOptions& o) {
 
 int run_bench(BenchOptions o) {
   const auto start = std::chrono::steady_clock::now();
-  ensure_output_dir(o.out);
+  const OutputDir output_dir(o.out);
   if (o.phantom.empty()) {
     if (std::filesystem::exists(kDefaultPhantom)) o.phantom = kDefaultPhantom;
     else std::printf("note: %s not found; phantom scenes left out (give --phantom)\n", kDefaultPhantom);

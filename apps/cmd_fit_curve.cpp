@@ -46,7 +46,7 @@ nlohmann::json fit_json(const CurveFitResult& r) {
 int run_fit_curve(const FitCurveCliOptions& o) {
   const Scene scene = load_scene(o.scene, o.precision);
   const ForceCurve curve = force_curve_from_rows(read_numeric_csv(o.curve, {"displacement_mm", "force_n"}), o.curve);
-  ensure_output_dir(o.out);
+  const OutputDir output_dir(o.out);
   const PreparedModel model = prepare_model(scene);
   const ClContext cl(select_device(o.device));
   CurveFitOptions options;

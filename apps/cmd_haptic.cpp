@@ -25,7 +25,7 @@ int run_haptic(const HapticCliOptions& o) {
   const Scene scene = load_scene(o.scene, o.precision);
   const ProbeTrajectory trajectory = trajectory_from_rows(
       read_numeric_csv(o.trajectory, {"time_s", "x_mm", "y_mm", "z_mm"}), o.trajectory);
-  ensure_output_dir(o.out);
+  const OutputDir output_dir(o.out);
   const PreparedModel model = prepare_model(scene);
   const ClContext cl(select_device(o.device));
   HapticOptions options;

@@ -45,7 +45,7 @@ std::string phantom_scene(const Phantom& p, const PhantomSpec& spec) {
 }
 
 int run_phantom(const PhantomOptions& o) {
-  ensure_output_dir(o.out);
+  const OutputDir output_dir(o.out);
   PhantomSpec spec;
   spec.seed = o.seed;
   spec.spacing_m = o.spacing_mm * 1e-3;

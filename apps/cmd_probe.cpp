@@ -23,7 +23,7 @@ struct ProbeOptions {
 int run_probe(const ProbeOptions& o) {
   const Scene scene = load_scene(o.scene, o.precision);
   require(scene.probe.active, "the scene has no [probe] section", o.scene, "add [probe] (docs/SCENE.md)");
-  ensure_output_dir(o.out);
+  const OutputDir output_dir(o.out);
   const ClContext cl(select_device(o.device));
   const PreparedModel model = prepare_model(scene);
   Simulator sim(scene, model.lattice, model.elements, cl);

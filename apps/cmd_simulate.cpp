@@ -20,7 +20,7 @@ int run_simulate(const SimulateOptions& o) {
   Scene scene = load_scene(o.scene, o.precision);
   if (!o.series.empty()) scene.model.series_uid = o.series;
   scene.model.allow_gaps = scene.model.allow_gaps || o.allow_gaps;
-  ensure_output_dir(o.out);  // fail before computing, not after
+  const OutputDir output_dir(o.out);  // fail before computing, not after
   const ClContext cl(select_device(o.device));
   Progress bar(!o.quiet);
   SimulationOptions options;

@@ -68,6 +68,21 @@ void ensure_output_dir(const std::string& dir) {
   fs::remove(probe, ec);
 }
 
+OutputDir::OutputDir(const std::string& dir) {
+  std::error_code ec;
+  for (fs::path p = fs::absolute(dir, ec).lexically_normal(); !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    if (p == p.parent_path()) break;  // the root
+    created_.push_back(p.string());
+  }
+  ensure_output_dir(dir);
+}
+
+OutputDir::~OutputDir() {
+  std::error_code ec;  // fs::remove deletes a folder only when it is empty; errors are ignored
+  for (const std::string& p : created_)
+    if (!fs::is_directory(p, ec) || !fs::is_empty(p, ec) || !fs::remove(p, ec)) break;
+}
+
 void write_text_atomically(const std::string& path, const std::string& text) {
   AtomicOutput out(path);
   std::FILE* f = std::fopen(out.temp_path().c_str(), "wb");

@@ -464,6 +464,24 @@ TEST_F(Writers, EnsureOutputDirCreatesParentsAndLeavesNoProbe) {
   ensure_output_dir(nested.string());  // existing folder is fine
 }
 
+TEST_F(Writers, OutputDirRemovesTheEmptyFoldersItCreated) {
+  const fs::path nested = dir_ / "new" / "run";
+  { const OutputDir out(nested.string()); EXPECT_TRUE(fs::is_directory(nested)); }
+  EXPECT_FALSE(fs::exists(dir_ / "new"));  // both created, both empty: both gone
+  EXPECT_TRUE(fs::is_directory(dir_));     // existed before: kept
+
+  {
+    const OutputDir out(nested.string());
+    write_text_atomically((nested / "summary.json").string(), "{}");
+  }
+  EXPECT_TRUE(fs::exists(nested / "summary.json"));  // written: kept
+
+  const fs::path sibling = dir_ / "new" / "other";
+  { const OutputDir out(sibling.string()); }
+  EXPECT_FALSE(fs::exists(sibling));
+  EXPECT_TRUE(fs::is_directory(dir_ / "new"));  // existed before this one (it holds "run"): kept
+}
+
 TEST_F(Writers, TempPathIsHiddenAndUniqueInTheSameFolder) {
   const std::string final_path = (dir_ / "result.h5").string();
   const AtomicOutput a(final_path), b(final_path);
