@@ -444,6 +444,16 @@ HuClass read_hu_class(const Section& s) {
 }
 
 /// Image models: a CT (NIfTI file or DICOM folder) classified by a label volume or HU classes.
+/// model.spacing (m). Above 0.1 m a lattice is coarser than any breast it could model: such a
+/// value is millimetres written where metres belong, refused with the conversion.
+std::optional<double> read_spacing(const Section& s) {
+  const std::optional<double> h = s.positive("spacing");
+  if (h && *h > 0.1)
+    s.fail("spacing", "must be at most 0.1 (metres), got " + format_number(*h),
+           "lengths in a scene are in metres: " + format_number(*h) + " mm is " + format_number(*h * 1e-3));
+  return h;
+}
+
 void read_image_model(const Section& s, ModelSpec& model) {
   model.image_path = *s.text("image");
   model.series_uid = s.text("series").value_or("");
@@ -464,7 +474,7 @@ void read_image_model(const Section& s, ModelSpec& model) {
     if (!(hi->array() > lo->array()).all()) s.fail("roi_max", "must exceed roi_min in every component");
     model.roi_m = std::make_pair(*lo, *hi);
   }
-  model.spacing_m = s.positive("spacing").value_or(0.0);
+  model.spacing_m = read_spacing(s).value_or(0.0);
 }
 
 ModelSpec read_model(const Section& s) {
@@ -485,7 +495,7 @@ ModelSpec read_model(const Section& s) {
   if (model.shapes.empty()) {
     s.fail("shape", "the model has no shapes", "add [[model.shape]] tables or model.image; see docs/SCENE.md");
   }
-  model.spacing_m = s.required("spacing", s.positive("spacing"));
+  model.spacing_m = s.required("spacing", read_spacing(s));
   return model;
 }
 

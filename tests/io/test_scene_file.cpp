@@ -378,6 +378,8 @@ std::vector<ErrorCase> error_cases() {
        "materials.gel.E", 10, {"missing required key", "no default material"}},
       {"ZeroSpacing", with("spacing = 0.002", "spacing = 0"), "model.spacing", 2, {"> 0"}},
       {"MissingSpacing", with("spacing = 0.002\n", ""), "model.spacing", 1, {"missing"}},
+      {"SpacingInMillimetres", with("spacing = 0.002", "spacing = 2"), "model.spacing", 2,
+       {"at most 0.1 (metres), got 2", "2 mm is 0.002"}},
       {"NoShapes", "[model]\nspacing = 0.002\n[materials.adipose]\nE = 3000.0\n", "model.shape", 1,
        {"the model has no shapes"}},
       {"ZeroDownsample", with("spacing = 0.002", "spacing = 0.002\ndownsample = 0"),
