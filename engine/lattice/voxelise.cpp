@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "engine/error.hpp"
 #include "engine/geometry/shapes.hpp"
@@ -35,8 +36,12 @@ LabelVolume voxelise_shapes(const Scene& scene) {
     count[a] = std::max(1L, last - first[a]);
   }
   const double voxels = double(count[0]) * double(count[1]) * double(count[2]);
-  require(voxels < 4.0e9, "the shapes span " + std::to_string(long(voxels)) + " voxels at this spacing",
-          "model.spacing", "increase the spacing or shrink the shapes");
+  if (!(voxels < 4.0e9)) {
+    char extent[96];
+    std::snprintf(extent, sizeof extent, "%.3g × %.3g × %.3g m", count[0] * h, count[1] * h, count[2] * h);
+    require(false, "the shapes span " + std::string(extent) + ", " + std::to_string(long(voxels)) + " voxels at this spacing",
+            "model.spacing", "lengths are in metres; increase the spacing or shrink the shapes");
+  }
   vol.dims = {int(count[0]), int(count[1]), int(count[2])};
   vol.spacing_m = h;
   vol.origin_m = Vec3((first[0] + 0.5) * h, (first[1] + 0.5) * h, (first[2] + 0.5) * h);

@@ -123,6 +123,19 @@ TEST(Lattice, ZeroSpacingIsAnError) {
   }
 }
 
+TEST(Lattice, TooManyVoxelsIsAnErrorNamingTheExtentInMetres) {
+  Scene s = test::box_scene(2, 2, 2, 0.001);  // a 2 mm box
+  s.model.spacing_m = 1e-6;                   // 2,000³ voxels
+  try {
+    voxelise_shapes(s);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("0.002 × 0.002 × 0.002 m, 8000000000 voxels"), std::string::npos) << what;
+    EXPECT_NE(what.find("lengths are in metres"), std::string::npos) << what;
+  }
+}
+
 TEST(Lattice, ModelWithNoElementsIsAnError) {
   Scene s = test::box_scene(1, 1, 1, 0.01);
   s.model.shapes[0].kind = ShapeSpec::Kind::Sphere;
