@@ -541,7 +541,13 @@ MaterialSpec read_material(const std::string& name, const Section& s) {
   const bool needs_E = m.law == "linear" || m.law == "biphasic" || m.law == "neo-hookean";
   if (needs_E && !E && !fallback && !m.rigid) s.fail("E", "missing required key", "'" + name + "' has no default material");
   m.youngs_modulus_pa = E.value_or(fallback ? fallback->youngs_modulus_pa : m.rigid ? 1e12 : 0.0);
-  m.density_kg_m3 = s.positive("density").value_or(m.density_kg_m3);
+  if (const std::optional<double> rho = s.positive("density")) {
+    // Tissue lies near 1000 kg/m³; below 10 it is g/cm³ (or t/m³) written where kg/m³ belongs.
+    if (*rho < 10 || *rho > 30000)
+      s.fail("density", "must lie in [10, 30000] kg/m³, got " + format_number(*rho),
+             "density is in kg/m³: " + format_number(*rho) + " g/cm³ is " + format_number(*rho * 1e3) + " kg/m³");
+    m.density_kg_m3 = *rho;
+  }
   m.poisson_ratio = s.number("nu").value_or(m.poisson_ratio);
   m.bulk_modulus_pa = s.positive("bulk_modulus").value_or(0.0);
   m.c10_pa = s.number("c10").value_or(0.0);

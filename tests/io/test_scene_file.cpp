@@ -378,6 +378,8 @@ std::vector<ErrorCase> error_cases() {
        "materials.gel.E", 10, {"missing required key", "no default material"}},
       {"ZeroSpacing", with("spacing = 0.002", "spacing = 0"), "model.spacing", 2, {"> 0"}},
       {"MissingSpacing", with("spacing = 0.002\n", ""), "model.spacing", 1, {"missing"}},
+      {"DensityInGramsPerCubicCentimetre", with("E = 3000.0", "E = 3000.0\ndensity = 1.05"),
+       "materials.adipose.density", 10, {"[10, 30000] kg/m³, got 1.05", "1.05 g/cm³ is 1050 kg/m³"}},
       {"SpacingInMillimetres", with("spacing = 0.002", "spacing = 2"), "model.spacing", 2,
        {"at most 0.1 (metres), got 2", "2 mm is 0.002"}},
       {"NoShapes", "[model]\nspacing = 0.002\n[materials.adipose]\nE = 3000.0\n", "model.shape", 1,
