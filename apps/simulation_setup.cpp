@@ -1,5 +1,6 @@
 #include "apps/simulation_setup.hpp"
 
+#include <cstdio>
 #include <filesystem>
 
 #include "engine/image/image_lattice.hpp"
@@ -23,6 +24,28 @@ ImageVolume load_ct(const ModelSpec& model, std::vector<std::string>& warnings) 
   return read_nifti(model.image_path);
 }
 
+namespace {
+
+/// Moduli below the softest tissue's (~0.3 kPa for fat at small strain) are almost surely kPa
+/// written where pascals belong; such a model sags without bound, so say why up front.
+void warn_implausible_moduli(const Scene& scene, const Lattice& lattice, std::vector<std::string>& warnings) {
+  constexpr double kSoftestTissuePa = 100;
+  for (const std::string& tissue : lattice.tissue_names) {
+    const auto it = scene.materials.find(tissue);
+    if (it == scene.materials.end()) continue;
+    const MaterialSpec& m = it->second;
+    const bool has_E = m.law == "linear" || m.law == "biphasic" || m.law == "neo-hookean";
+    if (m.rigid || !has_E || m.youngs_modulus_pa >= kSoftestTissuePa) continue;
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "materials.%s.E = %g Pa is below any soft tissue's modulus (100 Pa): E is in pascals (%g kPa is %g)",
+                  tissue.c_str(), m.youngs_modulus_pa, m.youngs_modulus_pa, m.youngs_modulus_pa * 1e3);
+    warnings.push_back(text);
+  }
+}
+
+}  // namespace
+
 PreparedModel prepare_model(const Scene& scene) {
   PreparedModel m;
   if (scene.model.from_image()) {
@@ -35,6 +58,7 @@ PreparedModel prepare_model(const Scene& scene) {
     m.lattice = build_lattice(voxelise_shapes(scene), scene.model.downsample);
   }
   m.elements = make_element_arrays(scene, m.lattice);
+  warn_implausible_moduli(scene, m.lattice, m.warnings);
   return m;
 }
 

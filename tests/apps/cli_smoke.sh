@@ -147,6 +147,14 @@ expect_error unwritable_output "cannot write to output folder" "$(scene)" /proc/
 expect_error missing_material "soft" "$(scene | sed 's/^\[materials.soft\]/[materials.other]/')"
 expect_error torus_tube_too_big "toml:22 key 'device.torus\[0\].minor_radius'" "$(scene; printf '[[device.torus]]\ncenter = [0.005, 0.005, 0.0]\naxis = [0.0, 0.0, 1.0]\nmajor_radius = 0.01\nminor_radius = 0.01\n')"
 
+# A modulus written in kPa where pascals belong runs, with a warning on stderr and in summary.json
+scene | sed 's/^E = 3000.0/E = 3.0/; /^\[gravity\]/,+1d' >"$work/kpa.toml"
+if "$bin" simulate "$work/kpa.toml" --out "$work/kpa" --quiet >/dev/null 2>"$work/kpa.err" &&
+   grep -q "^voxbreast: warning: materials.soft.E = 3 Pa .*(3 kPa is 3000)" "$work/kpa.err" &&
+   grep -q "materials.soft.E = 3 Pa" "$work/kpa/summary.json"; then
+  pass "modulus in kPa: $(cat "$work/kpa.err")"
+else fail "modulus in kPa warning"; cat "$work/kpa.err"; fi
+
 # A corrupt CT: the phantom scene with a truncated ct.nii.gz
 mkdir -p "$work/corrupt" && cp "$root/data-samples/phantom/labels.nii.gz" "$root/data-samples/phantom/scene.toml" "$work/corrupt/"
 head -c 2000 "$root/data-samples/phantom/ct.nii.gz" >"$work/corrupt/ct.nii.gz"
