@@ -443,7 +443,6 @@ HuClass read_hu_class(const Section& s) {
   return c;
 }
 
-/// Image models: a CT (NIfTI file or DICOM folder) classified by a label volume or HU classes.
 /// model.spacing (m). Above 0.1 m a lattice is coarser than any breast it could model: such a
 /// value is millimetres written where metres belong, refused with the conversion.
 std::optional<double> read_spacing(const Section& s) {
@@ -454,6 +453,7 @@ std::optional<double> read_spacing(const Section& s) {
   return h;
 }
 
+/// Image models: a CT (NIfTI file or DICOM folder) classified by a label volume or HU classes.
 void read_image_model(const Section& s, ModelSpec& model) {
   model.image_path = *s.text("image");
   model.series_uid = s.text("series").value_or("");
@@ -545,7 +545,8 @@ MaterialSpec read_material(const std::string& name, const Section& s) {
     // Tissue lies near 1000 kg/m³; below 10 it is g/cm³ (or t/m³) written where kg/m³ belongs.
     if (*rho < 10 || *rho > 30000)
       s.fail("density", "must lie in [10, 30000] kg/m³, got " + format_number(*rho),
-             "density is in kg/m³: " + format_number(*rho) + " g/cm³ is " + format_number(*rho * 1e3) + " kg/m³");
+             *rho < 10 ? "density is in kg/m³: " + format_number(*rho) + " g/cm³ is " + format_number(*rho * 1e3) + " kg/m³"
+                       : "density is in kg/m³ (tissue: 900–1100)");
     m.density_kg_m3 = *rho;
   }
   m.poisson_ratio = s.number("nu").value_or(m.poisson_ratio);

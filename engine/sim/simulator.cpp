@@ -34,8 +34,9 @@ constexpr std::size_t kVolumeGpuWorkGroup = 512;
 // and 13.5% at 262k (cube), 6–23% at 147k–246k (phantom; docs/PERF_NOTES.md change 24)
 constexpr std::size_t kSplitWorkGroup = 128, kSplitMaxElements = 98304;
 // Spring models up to this size take Heun's one-launch step on NVIDIA (kernels/persistent.cl):
-// it beat the launched step by 6% at 36k and 14–17% at 39k and 43k (cubes), lost 3% at 47k (cube)
-// and 26–53% at 64k–216k (H200; docs/PERF_NOTES.md changes 24 and 25).
+// up to 43k cubes it held ~70k steps/s in every round while the launched step, host-bound there,
+// ranged 60–78k (level in the mean); at 47k the launched step won by 3%, at 64k–216k by 26–53%
+// (H200; docs/PERF_NOTES.md changes 24 and 25).
 constexpr std::size_t kPersistentMaxElements = 45056;
 // GPU models above this size with a quarter or more held step over a list of their free elements
 // (VB_STEP_LIST): from 76k up the phantom gained with every law and integrator but hyperelastic
