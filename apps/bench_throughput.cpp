@@ -343,12 +343,11 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, c.law) +
                          (c.integrator == "relaxation" ? double(real_size) : 0.0);
     const double effective = bytes * double(n_free) * sps;
-    const char* integ = c.integrator.c_str();
     const char* prec = c.precision == Precision::Double ? "double" : "float";
     std::printf("%-12s %9zu elements (%zu free)  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
-                c.name.c_str(), n, n_free, c.law.c_str(), integ, prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
+                c.name.c_str(), n, n_free, c.law.c_str(), c.integrator.c_str(), prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
     std::fflush(stdout);
-    nlohmann::json row = {{"model", c.name}, {"elements", n}, {"free_elements", n_free}, {"law", c.law}, {"integrator", integ}, {"precision", prec},
+    nlohmann::json row = {{"model", c.name}, {"elements", n}, {"free_elements", n_free}, {"law", c.law}, {"integrator", c.integrator}, {"precision", prec},
                           {"steps_per_s", sps}, {"bytes_per_element_step", bytes}, {"effective_bandwidth_gb_s", effective / 1e9},
                           {"fraction_of_copy_bandwidth", effective / bandwidth},
                           {"device_bytes_per_element", double(sim.device_bytes()) / double(n)},
@@ -363,7 +362,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                           // elements on the short connection loop (PERF_NOTES.md change 22)
                           {"uniform_loop_elements", sim.uniform_elements()},
                           {"step_list", sim.step_list()}};
-    csv << c.name << "," << n << "," << c.law << "," << integ << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
+    csv << c.name << "," << n << "," << c.law << "," << c.integrator << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
         << "," << n_free << "\n";
     if (o.profile) {

@@ -34,8 +34,7 @@ void warn_implausible_moduli(const Scene& scene, const Lattice& lattice, std::ve
     const auto it = scene.materials.find(tissue);
     if (it == scene.materials.end()) continue;
     const MaterialSpec& m = it->second;
-    const bool has_E = m.law == "linear" || m.law == "biphasic" || m.law == "neo-hookean";
-    if (m.rigid || !has_E || m.youngs_modulus_pa >= kSoftestTissuePa) continue;
+    if (m.rigid || !m.law_takes_E() || m.youngs_modulus_pa >= kSoftestTissuePa) continue;
     char text[240];
     std::snprintf(text, sizeof text,
                   "materials.%s.E = %g Pa is below any soft tissue's modulus (100 Pa): E is in pascals (%g kPa is %g)",

@@ -74,10 +74,17 @@ OutputDir::OutputDir(const std::string& dir) {
     if (p == p.parent_path()) break;  // the root
     created_.push_back(p.string());
   }
-  ensure_output_dir(dir);
+  try {
+    ensure_output_dir(dir);
+  } catch (...) {  // created, then found unwritable: no destructor runs for a failed constructor
+    remove_empty_created();
+    throw;
+  }
 }
 
-OutputDir::~OutputDir() {
+OutputDir::~OutputDir() { remove_empty_created(); }
+
+void OutputDir::remove_empty_created() const noexcept {
   std::error_code ec;  // fs::remove deletes a folder only when it is empty; errors are ignored
   for (const std::string& p : created_)
     if (!fs::is_directory(p, ec) || !fs::is_empty(p, ec) || !fs::remove(p, ec)) break;

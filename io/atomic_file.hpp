@@ -46,6 +46,8 @@ class OutputDir {
   OutputDir& operator=(const OutputDir&) = delete;
 
  private:
+  void remove_empty_created() const noexcept;
+
   std::vector<std::string> created_;  // innermost first
 };
 

@@ -538,8 +538,7 @@ MaterialSpec read_material(const std::string& name, const Section& s) {
   }
   m.rigid = s.boolean("rigid").value_or(m.rigid);
   const std::optional<double> E = s.positive("E");
-  const bool needs_E = m.law == "linear" || m.law == "biphasic" || m.law == "neo-hookean";
-  if (needs_E && !E && !fallback && !m.rigid) s.fail("E", "missing required key", "'" + name + "' has no default material");
+  if (m.law_takes_E() && !E && !fallback && !m.rigid) s.fail("E", "missing required key", "'" + name + "' has no default material");
   m.youngs_modulus_pa = E.value_or(fallback ? fallback->youngs_modulus_pa : m.rigid ? 1e12 : 0.0);
   if (const std::optional<double> rho = s.positive("density")) {
     // Tissue lies near 1000 kg/m³; below 10 it is g/cm³ (or t/m³) written where kg/m³ belongs.

@@ -15,8 +15,7 @@ std::vector<std::string> default_fit_parameters(const MaterialSpec& m) {
 void check_fit_parameter(const MaterialSpec& m, const std::string& name) {
   const std::string where = "materials." + m.name;
   if (name == "E") {
-    require(m.law == "linear" || m.law == "biphasic" || m.law == "neo-hookean",
-            "E is not a parameter of law '" + m.law + "'", where, "fit mu and alpha for ogden");
+    require(m.law_takes_E(), "E is not a parameter of law '" + m.law + "'", where, "fit mu and alpha for ogden");
     require(m.youngs_modulus_pa > 0, "E must start positive", where);
   } else if (name == "cubic" || name == "critical_strain") {
     require(m.law == "biphasic", name + " is a parameter of biphasic springs, not of law '" + m.law + "'", where);

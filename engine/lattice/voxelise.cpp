@@ -39,8 +39,8 @@ LabelVolume voxelise_shapes(const Scene& scene) {
   if (!(voxels < 4.0e9)) {
     char extent[96];
     std::snprintf(extent, sizeof extent, "%.3g × %.3g × %.3g m", count[0] * h, count[1] * h, count[2] * h);
-    require(false, "the shapes span " + std::string(extent) + ", " + std::to_string(long(voxels)) + " voxels at this spacing",
-            "model.spacing", "lengths are in metres; increase the spacing or shrink the shapes");
+    throw Error("the shapes span " + std::string(extent) + ", " + std::to_string(long(voxels)) + " voxels at this spacing",
+                "model.spacing", "lengths are in metres; increase the spacing or shrink the shapes");
   }
   vol.dims = {int(count[0]), int(count[1]), int(count[2])};
   vol.spacing_m = h;

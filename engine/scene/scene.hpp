@@ -67,6 +67,9 @@ struct MaterialSpec {
   double critical_strain = 0;          ///< biphasic springs: critical strain εc (dimensionless)
   bool rigid = false;  ///< held in place (bone): no motion, anchors its soft neighbours
   int line = 0;
+
+  /// Whether the law is parametrised by Young's modulus E (the others by c10, or μ and α).
+  bool law_takes_E() const { return law == "linear" || law == "biphasic" || law == "neo-hookean"; }
 };
 
 /// Relaxation: dynamic relaxation for the static answer only (fictitious masses and damping;
