@@ -9,6 +9,7 @@
 #include "engine/device/torus.hpp"
 #include "engine/error.hpp"
 #include "engine/sim/kernel_tables.hpp"
+#include "engine/sim/step_list_rule.hpp"
 #include "engine/sim/triangle_contact.hpp"
 #include "engine/sim/uniform_neighbourhood.hpp"
 #include "engine/surface/enclosed_volume.hpp"
@@ -38,10 +39,6 @@ constexpr std::size_t kSplitWorkGroup = 128, kSplitMaxElements = 98304;
 // ranged 60–78k (level in the mean); at 47k the launched step won by 3%, at 64k–216k by 26–53%
 // (H200; docs/PERF_NOTES.md changes 24 and 25).
 constexpr std::size_t kPersistentMaxElements = 45056;
-// GPU models above this size with a quarter or more held step over a list of their free elements
-// (VB_STEP_LIST): from 76k up the phantom gained with every law and integrator but hyperelastic
-// relaxation at 76k (−1 to −2%); at 18k its hyperelastic relaxation lost 10% (change 24).
-constexpr std::size_t kStepListMinElements = 65536;
 constexpr int kCheckBaseSlots = 5, kCheckSlotsPerIndenter = 4;  // kernels/checks.cl
 constexpr int kCheckSlotsPerTorus = 8;                             // VB_TORUS_SLOTS
 constexpr int kIndenterStride = 20;                                // VB_IND_STRIDE
@@ -465,15 +462,13 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
   persistent_ = plan_persistent_step(cl.info, heun_steps && !tri_contact_ && !folded, el.hyperelastic, n_,
                                      force_split_, kPersistentMaxElements);
   // The stepping kernels over a list of the free elements (kernels/common.cl, VB_STEP_LIST), on
-  // GPUs for models above 65,536 elements of which at least a quarter are held: those then cost
-  // no work-item and no copy of their state per step (the phantom, two thirds held: Heun +10% at
-  // 76k, +16% at 1.5M, up to +38% between; relaxation and Euler +2% to +41%). Smaller models are
-  // bound by each pass's chain of dependent loads, which the list lengthens (the 18k phantom's
-  // hyperelastic relaxation lost 10%; PERF_NOTES.md changes 23, 24). Not with the lanes kernels
-  // (their own list), the split force pass or the one-launch step (their own layouts).
+  // GPUs for large models with a quarter or more held (step_list_rule.hpp): those then cost no
+  // work-item and no copy of their state per step (the phantom, two thirds held: Heun +10% at
+  // 76k, +16% at 1.5M, up to +38% between; relaxation and Euler +2% to +41%). Not with the lanes
+  // kernels (their own list), the split force pass or the one-launch step (their own layouts).
   // VOXBREAST_STEP_LIST=0|1 overrides the device rule, not the others.
   const bool list_allowed = !lanes_ && force_split_ == 1 && !persistent_.on;
-  step_list_ = list_allowed && cl.info.is_gpu && n_ > kStepListMinElements && 4 * el.held_count >= n_;
+  step_list_ = list_allowed && default_step_list(cl.info.is_gpu, n_, el.held_count, relax_ && el.hyperelastic);
   if (const char* env = std::getenv("VOXBREAST_STEP_LIST")) step_list_ = list_allowed && std::atoi(env) != 0;
   // Linear springs on GPUs: elements whose neighbours share their E and mass take a short
   // connection loop (kernels/lattice_forces.cl, lattice_force_uniform; PERF_NOTES.md change 22),
