@@ -169,10 +169,12 @@ void print_launch_floor(const ClContext& cl) {
 /// stage 2 reads u, v, ũ, ṽ, E, cell, grid and writes u, v. Hyperelastic tissues add, per
 /// stage, the stress pass (reads u, cell, grid, tissue; writes Q and C: 4 vectors) and the
 /// gather's read of the element's own Q and C and tissue. Biphasic springs add the element's own
-/// tissue id per stage (the neighbours' ids and material rows are neighbour reads).
-double heun_bytes_per_element(std::size_t real_size, const std::string& law) {
+/// tissue id per stage (the neighbours' ids and material rows are neighbour reads). With the
+/// predicted stage packed (Simulator::pred_packed) ũ, ṽ are 6 reals, written once and read once.
+double heun_bytes_per_element(std::size_t real_size, const std::string& law, bool pred_packed) {
   const double vec = 4.0 * double(real_size), scalar = double(real_size), idx = 4.0;
-  const double springs = (2 * vec + scalar + 2 * idx + 2 * vec) + (4 * vec + scalar + 2 * idx + 2 * vec);
+  const double stage = pred_packed ? 6 * scalar : 2 * vec;  // ũ, ṽ
+  const double springs = (2 * vec + scalar + 2 * idx + stage) + (2 * vec + stage + scalar + 2 * idx + 2 * vec);
   const double stress_pass = (vec + 2 * idx + 1 + 4 * vec) + (4 * vec + 1);
   if (law == "linear") return springs;
   if (law == "biphasic") return springs + 2 * 1.0;
@@ -340,7 +342,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     const std::size_t real_size = c.precision == Precision::Double ? 8 : 4;
     // one stage for Euler, and for relaxation with the element's mass scale
     const bool heun = c.integrator == "heun";
-    const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, c.law) +
+    const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, c.law, heun && sim.pred_packed()) +
                          (c.integrator == "relaxation" ? double(real_size) : 0.0);
     const double effective = bytes * double(n_free) * sps;
     const char* prec = c.precision == Precision::Double ? "double" : "float";
@@ -361,7 +363,9 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                           {"lanes_kernels", sim.lanes()},
                           // elements on the short connection loop (PERF_NOTES.md change 22)
                           {"uniform_loop_elements", sim.uniform_elements()},
-                          {"step_list", sim.step_list()}};
+                          {"step_list", sim.step_list()},
+                          // Heun's predicted stage packed (PERF_NOTES.md change 27)
+                          {"pred_packed", sim.pred_packed()}};
     csv << c.name << "," << n << "," << c.law << "," << c.integrator << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
         << "," << n_free << "\n";

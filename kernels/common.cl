@@ -18,14 +18,17 @@
 //   -DVB_ARENA_UNIT=N  the unit of the arena offsets (bytes, engine/sim/device_arena.hpp)
 //   -DVB_NV_PTX=0|1   NVIDIA device: inline PTX for device-scope fences (vb_device_fence)
 //   -DVB_PERSISTENT=0|1  Heun's whole step in one launch (kernels/persistent.cl, NVIDIA only)
+//   -DVB_PRED_PACKED=0|1  Heun's predicted stage packed (kernels/lattice_forces.cl, stage_load)
 // and prepends the lattice tables (VB_DIR, VB_DIR_LEN, VB_KAPPA) generated from the host's
 // single definition (engine/sim/kernel_tables.cpp).
 #if VB_DOUBLE
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 typedef double real;
+typedef double2 real2;
 typedef double4 real4;
 #else
 typedef float real;
+typedef float2 real2;
 typedef float4 real4;
 #endif
 

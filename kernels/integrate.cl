@@ -126,7 +126,7 @@ VB_INLINE real4 split_lattice_force(int active, uint e, real4 ui, real4 vi, glob
   real4 f = (real4)(0);
   if (active)
     f = lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, (int)(26 * part / VB_SPLIT),
-                              (int)(26 * (part + 1) / VB_SPLIT));
+                              (int)(26 * (part + 1) / VB_SPLIT), 0, u);
   if (part) share[l] = f;
   barrier(CLK_LOCAL_MEM_FENCE);
   if (!part)
@@ -138,23 +138,23 @@ VB_INLINE real4 split_lattice_force(int active, uint e, real4 ui, real4 vi, glob
 #endif
 
 // One explicit stage from (u, v): symplectic Euler updates v first and moves with the new v;
-// Heun's predictor (explicit Euler) moves with the old v. `symplectic` is a constant at each call.
+// Heun's predictor (explicit Euler) moves with the old v. `symplectic` and `pack` (the stage
+// written packed: Heun's predictor with VB_PRED_PACKED) are constants at each call.
 // (u, v) may have a volume projection pending (kernels/common.cl): the stage starts from the
 // projected state, its own included.
 VB_INLINE void explicit_stage(uint e, global const real4* u, global const real4* v, global real4* u_out,
                               global real4* v_out, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt,
-                              uint n, int symplectic, VB_PENDING_PARAMS, VB_LAG_PARAMS VB_TRI_PARAMS) {
+                              uint n, int symplectic, int pack, VB_PENDING_PARAMS, VB_LAG_PARAMS VB_TRI_PARAMS) {
   if (e >= n) return;
   real4 ui = u[e], vi = v[e], wg = (real4)(0);
   pending_u(&ui, &wg, e, VB_PENDING_ARGS);
   pending_v(&vi, wg, VB_PENDING_ARGS);
   if (ui.w != 0) {
     const real4 f =
-        less_lag(lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, 0, 26), e, VB_LAG_ARGS);
+        less_lag(lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, 0, 26, 0, u), e, VB_LAG_ARGS);
     explicit_update(e, &ui, &vi, f, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, symplectic VB_TRI_ARGS);
   }
-  u_out[e] = ui;
-  v_out[e] = vi;
+  stage_store(u_out, v_out, e, pack, ui, vi);
 }
 
 // The stepping kernels' entries take u, v and where the stage goes as state arena offsets
@@ -176,7 +176,7 @@ kernel void euler_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENT
   VB_UNPACK_LATTICE;
   VB_UNPACK_STEP_STATE(const, );
   explicit_stage(VB_STEP_INDEX(get_global_id(0)), u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt,
-                 VB_STEP_N, 1, VB_NO_PENDING, VB_NO_LAG VB_TRI_ARGS);
+                 VB_STEP_N, 1, 0, VB_NO_PENDING, VB_NO_LAG VB_TRI_ARGS);
 }
 
 // With VB_VOLUME_FOLD (Heun with the volume constraint, kernels/volume.cl: volume_pending) the
@@ -214,7 +214,8 @@ VB_INLINE void predict_element(uint e, global const real4* u, global const real4
   u_pred[e] = ui;
   v_pred[e] = vi;
 #else
-  explicit_stage(e, u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0, VB_PENDING_ARGS, VB_LAG_ARGS
+  explicit_stage(e, u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0, VB_PRED_PACKED, VB_PENDING_ARGS,
+                 VB_LAG_ARGS
                  VB_TRI_ARGS);
 #endif
 }
@@ -222,7 +223,8 @@ VB_INLINE void predict_element(uint e, global const real4* u, global const real4
 // Heun's corrector for element e (u', v' into u, v; the same calling rule as predict_element):
 // `pending` of the state (u, v) for the element's own u, v, and pred_* of the predicted stage.
 // The element's own u, v are read after the force loop, so they are not live across it (fewer
-// registers: PERF_NOTES.md change 20); the held test reads ũ.w, which the predictor copies from u.
+// registers: PERF_NOTES.md change 20); the held test reads ũ.w, which the predictor copies from u
+// (packed, VB_PRED_PACKED: u.w itself).
 VB_INLINE void correct_element(uint e, global real4* u, global real4* v, global const real4* u_pred,
                                global const real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt, uint n,
                                VB_PENDING_PARAMS, global const real4* pred_g, real pred_lambda, real pred_mu,
@@ -233,8 +235,7 @@ VB_INLINE void correct_element(uint e, global real4* u, global real4* v, global 
 #endif
   real4 up = (real4)(0), vp = (real4)(0), wgp = (real4)(0);
   if (in) {
-    up = u_pred[e];
-    vp = v_pred[e];
+    stage_load(u_pred, v_pred, e, VB_PRED_PACKED, u, &up, &vp);
     pending_u(&up, &wgp, e, pred_g, pred_lambda, pred_mu, pred_pending);
     pending_v(&vp, wgp, pred_g, pred_lambda, pred_mu, pred_pending);
   }
@@ -246,7 +247,7 @@ VB_INLINE void correct_element(uint e, global real4* u, global real4* v, global 
 #else
   if (up.w == 0) return;
   const real4 f = lattice_force_pending(e, up, vp, u_pred, v_pred, VB_LATTICE_ARGS, pred_g, pred_lambda, pred_mu,
-                                        pred_pending, 0, 26);
+                                        pred_pending, 0, 26, VB_PRED_PACKED, u);
 #endif
   real4 ui = u[e], vi = v[e], wg = (real4)(0);
   pending_u(&ui, &wg, e, VB_PENDING_ARGS);

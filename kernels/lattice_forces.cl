@@ -25,6 +25,44 @@ inline real spring_end(int law, global const real* mat, real k, real len, real r
 #define spring_end(law, mat, k, len, rest) ((real)0.5 * (k) * ((len) - (rest)))
 #endif
 
+// Heun's predicted stage packed (VB_PRED_PACKED; Simulator::pred_packed_): its u array holds
+// (ũx, ũy, ũz, ṽx) and its v array's first half (ṽy, ṽz) as real2, so a warp's read of a
+// neighbour's state touches 4 + 2 cache lines instead of 4 + 4: the reads cost by the lines they
+// touch (1.5M cube, H200: the step 10-12% shorter; docs/PERF_NOTES.md change 27). The inverse mass
+// is not in it: it stays in the state's u.w (w_of), which no stage changes (heun_correct writes
+// each u[e] back with the same w, so a neighbour reads the same inverse mass before or after).
+// `packed` is a constant at every call (0: the stage as two real4 arrays). Only the host's plain
+// case uses it: one work-item per element, no step list, nothing else reading the stage.
+#ifndef VB_PRED_PACKED
+#define VB_PRED_PACKED 0
+#endif
+#if VB_PRED_PACKED && (VB_SPLIT > 1 || VB_VOLUME || VB_STEP_LIST || VB_LANES || VB_TRI_CONTACT || VB_PERSISTENT || \
+                       VB_INDENTERS || VB_TORI || VB_HYPER || VB_BIPHASIC)
+#error "VB_PRED_PACKED: the predicted stage is read as two real4 arrays by this configuration"
+#endif
+#define VB_STAGE_PARAMS int packed, global const real4 *w_of
+VB_INLINE void stage_load(global const real4* u, global const real4* v, uint j, VB_STAGE_PARAMS, real4* uj,
+                          real4* vj) {
+  if (!packed) {
+    *uj = u[j];
+    *vj = v[j];
+    return;
+  }
+  const real4 a = u[j];
+  const real2 b = ((global const real2*)v)[j];
+  *uj = (real4)(a.x, a.y, a.z, w_of[j].w);
+  *vj = (real4)(a.w, b.x, b.y, 0);
+}
+VB_INLINE void stage_store(global real4* u, global real4* v, uint e, int packed, real4 ue, real4 ve) {
+  if (!packed) {
+    u[e] = ue;
+    v[e] = ve;
+    return;
+  }
+  u[e] = (real4)(ue.x, ue.y, ue.z, ve.x);
+  ((global real2*)v)[e] = (real2)(ve.y, ve.z);
+}
+
 // Linear springs only (no rest offsets): the force on a free element whose present neighbours all
 // have its E and inverse mass w, which the host marks with a negative E (engine/sim/
 // uniform_neighbourhood.hpp). Then E_ij = E, k = κ_d·h·E and the dashpot's 2ζ·√(k/(2w)) =
@@ -34,7 +72,8 @@ inline real spring_end(int law, global const real* mat, real k, real len, real r
 // VB_UNIFORM_PATH (host: GPUs, linear springs, no rest offsets, not in the one-launch step).
 #if VB_UNIFORM_PATH
 VB_INLINE real4 lattice_force_uniform(uint e, real Ei, real4 ui, real4 vi, global const real4* u,
-                                      global const real4* v, VB_LATTICE_PARAMS, VB_PENDING_PARAMS, int d_lo, int d_hi) {
+                                      global const real4* v, VB_LATTICE_PARAMS, VB_PENDING_PARAMS, int d_lo, int d_hi,
+                                      VB_STAGE_PARAMS) {
   const int cell = (int)cell_of[e];
 #if VB_DASHPOT
   const real damping_e = 2 * dashpot_ratio * sqrt(h * Ei / (2 * ui.w));
@@ -46,7 +85,8 @@ VB_INLINE real4 lattice_force_uniform(uint e, real Ei, real4 ui, real4 vi, globa
     const int jn = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
     const real present = jn >= 0 ? (real)1 : (real)0;
     const int j = jn >= 0 ? jn : (int)e;
-    real4 uj = u[j], wgj = (real4)(0);
+    real4 uj, vj, wgj = (real4)(0);
+    stage_load(u, v, (uint)j, packed, w_of, &uj, &vj);
     pending_u(&uj, &wgj, (uint)j, VB_PENDING_ARGS);
     const real4 r = (real4)(h * VB_DIR[d][0] + (uj.x - ui.x), h * VB_DIR[d][1] + (uj.y - ui.y),
                             h * VB_DIR[d][2] + (uj.z - ui.z), 0);
@@ -62,7 +102,6 @@ VB_INLINE real4 lattice_force_uniform(uint e, real Ei, real4 ui, real4 vi, globa
     const real k = present * (VB_KAPPA[d] * h * Ei);
     real magnitude = k * (len - h * VB_DIR_LEN[d]);
 #if VB_DASHPOT
-    real4 vj = v[j];
     pending_v(&vj, wgj, VB_PENDING_ARGS);
     magnitude += present * (damping_e * VB_SQRT_KAPPA[d]) * dot3(vj - vi, n);
 #endif
@@ -85,10 +124,11 @@ VB_INLINE real4 lattice_force_uniform(uint e, real Ei, real4 ui, real4 vi, globa
 // d_hi are summed (kernels/integrate.cl, VB_SPLIT: parts of an element's connections on several
 // work-items); 0, 26 for all.
 VB_INLINE real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                                      VB_LATTICE_PARAMS, VB_PENDING_PARAMS, int d_lo, int d_hi) {
+                                      VB_LATTICE_PARAMS, VB_PENDING_PARAMS, int d_lo, int d_hi, VB_STAGE_PARAMS) {
 #if VB_UNIFORM_PATH
   const real E_marked = E[e];
-  if (E_marked < 0) return lattice_force_uniform(e, -E_marked, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, d_lo, d_hi);
+  if (E_marked < 0) return lattice_force_uniform(e, -E_marked, ui, vi, u, v, VB_LATTICE_ARGS, VB_PENDING_ARGS, d_lo, d_hi,
+                                                     packed, w_of);
   const real Ei = E_marked;
 #else
   const real Ei = E[e];
@@ -114,7 +154,8 @@ VB_INLINE real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const r
     const int jn = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
     const real present = jn >= 0 ? (real)1 : (real)0;
     const int j = jn >= 0 ? jn : (int)e;
-    real4 uj = u[j], wgj = (real4)(0);
+    real4 uj, vj, wgj = (real4)(0);
+    stage_load(u, v, (uint)j, packed, w_of, &uj, &vj);
     pending_u(&uj, &wgj, (uint)j, VB_PENDING_ARGS);
     const real4 hd = (real4)(h * VB_DIR[d][0], h * VB_DIR[d][1], h * VB_DIR[d][2], 0);
     const real4 r = (real4)(hd.x + (uj.x - ui.x), hd.y + (uj.y - ui.y), hd.z + (uj.z - ui.z), 0);
@@ -180,7 +221,6 @@ VB_INLINE real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const r
     real magnitude = k * (len - rest);
 #endif
 #if VB_DASHPOT
-    real4 vj = v[j];
     pending_v(&vj, wgj, VB_PENDING_ARGS);
     magnitude += 2 * dashpot_ratio * sqrt(kE * q) * dot3(vj - vi, n);
 #endif
@@ -194,7 +234,7 @@ VB_INLINE real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const r
 
 VB_INLINE real4 lattice_force(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
                               VB_LATTICE_PARAMS) {
-  return lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_NO_PENDING, 0, 26);
+  return lattice_force_pending(e, ui, vi, u, v, VB_LATTICE_ARGS, VB_NO_PENDING, 0, 26, 0, u);
 }
 
 // Net force on a free element from the lattice and gravity (N), before contact constraints.

@@ -229,6 +229,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   const std::size_t frame_bytes = (rest_offsets_ && hyper_ ? 3 * n_ : 1) * 4 * real_size_;
   if (rest_offsets_) device_bytes_ += offset_bytes + (hyper_ ? frame_bytes : 0);
   make_model_arena(el, grid, cell_of, offset_bytes);
+  plan_pred_packing(scene, el, cl);  // after the short loop's marks
   for (const IndenterSpec& ind : scene.indenters) {  // before the obstacle table (state arena)
     motion_.push_back({ind.start_m, ind.velocity_m_s, 0.0, ind.travel_time_s});
     if (!ind.path.empty()) motion_.back() = {ind.path.front().position_m, Vec3::Zero(), 0.0, 0.0};
@@ -281,6 +282,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_CHECK_SLOTS=" + std::to_string(check_slots_);
   options += " -DVB_RSQRT=" + std::to_string(cl.info.is_gpu);
   options += " -DVB_UNIFORM_PATH=" + std::to_string(uniform_path_);
+  options += " -DVB_PRED_PACKED=" + std::to_string(pred_packed_);
   // Denormal floats (< 1.2e-38: nothing in m, N, Pa) flushed to zero on GPUs: NVIDIA's rsqrt,
   // rcp and sqrt then skip their denormal fix-up: the 1.5M linear Heun float step 3-4.5% shorter
   // on the H200 (device time).
@@ -422,6 +424,23 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   if (tri_contact_) make_triangle_contact_buffers();
   if (persistent_.on) make_persistent_kernel();
   if (rest_offsets_) set_rest_offsets(std::vector<double>(3 * n_, 0.0));  // R₀ = I, J₀ = 1
+}
+
+// Heun's predicted stage packed (kernels/lattice_forces.cl, stage_load): ũ with ṽx in one real4,
+// ṽy, ṽz in a real2, so a warp's read of a neighbour's stage touches 6 cache lines instead of 8
+// (H200, linear cubes: heun_correct 10% shorter, the step 3-5% at 1.5M, 7% at 512k; docs/
+// PERF_NOTES.md change 27). Where the short loop takes at least half the free elements: the general
+// loop reads each neighbour's inverse mass from the state, a third line (the phantom at 50k-60k,
+// none on the short loop: 0 to 5% slower). Only where heun_correct alone reads the stage: no volume
+// constraint, indenters, tori or triangle contact, one work-item per element and no list (whose
+// held elements' stage is a copy of the state). VOXBREAST_PRED_PACKED=0|1 overrides the device
+// rule and the half, not the others.
+void Simulator::plan_pred_packing(const Scene& scene, const ElementArrays& el, const ClContext& cl) {
+  const bool allowed = scene.solver.integrator == Integrator::Heun && uniform_path_ && force_split_ == 1 &&
+                       !persistent_.on && !step_list_ && !lanes_ && !volume_ && scene.indenters.empty() &&
+                       scene.tori.empty() && !tri_contact_;
+  pred_packed_ = allowed && default_pred_packing(cl.info.is_gpu, uniform_elements_, n_ - el.held_count);
+  if (const char* env = std::getenv("VOXBREAST_PRED_PACKED")) pred_packed_ = allowed && std::atoi(env) != 0;
 }
 
 void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const ClContext& cl) {

@@ -163,6 +163,8 @@ class Simulator {
   /// and how many do (engine/sim/uniform_neighbourhood.hpp).
   bool uniform_path() const { return uniform_path_; }
   std::size_t uniform_elements() const { return uniform_elements_; }
+  /// Whether Heun's predicted stage is stored packed (ũ, ṽx | ṽy, ṽz; kernels/lattice_forces.cl).
+  bool pred_packed() const { return pred_packed_; }
   /// Whether the stepping kernels run over a list of the free elements (GPUs; kernels/integrate.cl).
   bool step_list() const { return step_list_; }
   /// The volume constraint's scalars as the last kernel left them (kernels/volume.cl; lattice
@@ -224,6 +226,8 @@ class Simulator {
   /// Decides the launch schedule (volume launches, force split, lanes, one-launch step, lagged
   /// pressure, paired stress) before anything is allocated: the arena depends on it.
   void plan_launches(const Scene& scene, const ElementArrays& el, const ClContext& cl);
+  /// Whether Heun's predicted stage is stored packed (pred_packed_): after the short loop's marks.
+  void plan_pred_packing(const Scene& scene, const ElementArrays& el, const ClContext& cl);
   void make_model_arena(const ElementArrays& el, const std::vector<cl_int>& grid, const std::vector<cl_uint>& cell_of,
                         std::size_t offset_bytes);
   std::vector<unsigned char> real_bytes(const std::vector<double>& values) const;  ///< in the model's precision
@@ -346,6 +350,7 @@ class Simulator {
   bool volume_lag_ = false;  ///< Heun's predicted stage (relaxation's step) under the lagged pressure
   bool uniform_path_ = false;  ///< linear springs: uniform neighbourhoods marked, their short loop compiled in
   std::size_t uniform_elements_ = 0;  ///< elements marked
+  bool pred_packed_ = false;  ///< Heun's predicted stage packed (VB_PRED_PACKED)
   DeviceArena vol_mesh_;  ///< triangles, surface elements, incident start, incident (kernels/volume.cl)
   cl_uint4 vol_mesh_at_{};
   cl::Buffer vol_grad_, vol_partial_,

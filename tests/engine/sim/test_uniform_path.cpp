@@ -63,15 +63,19 @@ TEST(UniformNeighbourhood, MarksElementsWhoseNeighboursShareModulusAndMass) {
 }
 
 /// u then v after 300 steps from rest (checks every 100: relaxation sets its damping there).
-std::vector<double> run(const Scene& s, bool uniform) {
+/// `packed`: Heun's predicted stage packed (1) or not (0), asked for and expected; -1: the default.
+std::vector<double> run(const Scene& s, bool uniform, int packed = -1) {
   const test::Model m = test::make_model(s);
   const std::unique_ptr<Simulator> made = [&] {
     const test::ScopedEnv path("VOXBREAST_UNIFORM_PATH", uniform ? "1" : "0");
     const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");  // GPUs: no short loop in the one-launch step
+    const test::ScopedEnv pack("VOXBREAST_PRED_PACKED", packed == 1 ? "1" : "0");
+    const test::ScopedEnv lanes("VOXBREAST_LANES", "0");  // CPUs, float: the lanes kernels have no short loop
     return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
   }();
   Simulator& sim = *made;
   EXPECT_EQ(sim.uniform_path(), uniform);
+  if (packed >= 0) EXPECT_EQ(sim.pred_packed(), packed == 1);
   // Enough elements on each loop for the comparison to mean something: marked one by one (CPUs)
   // most of the block's free elements, not those next to the inclusion, the heavy layer or the
   // base; in whole warps of 32 (NVIDIA) fewer, 138 of 810.
@@ -101,6 +105,51 @@ TEST(UniformPath, MatchesTheGeneralLoop) {
       std::cout << "integrator " << int(integrator) << (volume ? ", volume" : "") << ": short vs general loop " << d << "\n";
       EXPECT_LE(d, 1e-11);
     }
+}
+
+// Heun's predicted stage packed (kernels/lattice_forces.cl, stage_load; by default on GPUs with
+// the short loop): the same values read from other addresses, so the same trajectory to the last
+// bit in both precisions. The block's general-loop elements (next to the inclusion, the heavy
+// layer and the base) read their neighbours' inverse mass from the state instead of the stage.
+TEST(UniformPath, PackedPredictedStageChangesNoBit) {
+  for (const Precision precision : {Precision::Float, Precision::Double}) {
+    Scene s = test::mixed_block(Integrator::Heun, false);
+    s.solver.precision = precision;
+    const std::vector<double> packed = run(s, true, 1), plain = run(s, true, 0);
+    ASSERT_EQ(packed.size(), plain.size());
+    double moved = 0;  // the block sags under gravity: the comparison is of a motion
+    for (double x : plain) moved = std::max(moved, std::abs(x));
+    EXPECT_GT(moved, 1e-5);
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < plain.size(); ++i) differing += packed[i] != plain[i];
+    EXPECT_EQ(differing, 0u) << (precision == Precision::Float ? "float" : "double");
+  }
+}
+
+// Nor where anything but the corrector reads the stage: the volume constraint (its projection of
+// the predicted stage), the short loop off (the general loop alone), other integrators.
+TEST(UniformPath, PredictedStageStaysUnpackedWhereOthersReadIt) {
+  const auto packed = [](const Scene& s, bool uniform) {
+    const test::Model m = test::make_model(s);
+    const test::ScopedEnv path("VOXBREAST_UNIFORM_PATH", uniform ? "1" : "0");
+    const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");
+    const test::ScopedEnv pack("VOXBREAST_PRED_PACKED", "1");
+    return Simulator(s, m.lattice, m.elements, test::cl_context()).pred_packed();
+  };
+  EXPECT_TRUE(packed(test::mixed_block(Integrator::Heun, false), true));
+  EXPECT_FALSE(packed(test::mixed_block(Integrator::Heun, true), true));
+  EXPECT_FALSE(packed(test::mixed_block(Integrator::Heun, false), false));
+  EXPECT_FALSE(packed(test::mixed_block(Integrator::SymplecticEuler, false), true));
+}
+
+// By default on GPUs where the short loop takes at least half the free elements (the cubes, not
+// the phantom, whose tissue interfaces leave it almost none in whole warps).
+TEST(UniformPath, PredictedStagePackedByDefaultWhereTheShortLoopTakesHalf) {
+  EXPECT_TRUE(default_pred_packing(true, 50, 100));
+  EXPECT_TRUE(default_pred_packing(true, 1507650, 1507650));
+  EXPECT_FALSE(default_pred_packing(true, 49, 100));
+  EXPECT_FALSE(default_pred_packing(true, 0, 20969));
+  EXPECT_FALSE(default_pred_packing(false, 100, 100));
 }
 
 }  // namespace
