@@ -215,8 +215,7 @@ VB_INLINE void predict_element(uint e, global const real4* u, global const real4
   v_pred[e] = vi;
 #else
   explicit_stage(e, u, v, u_pred, v_pred, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, n, 0, VB_PRED_PACKED, VB_PENDING_ARGS,
-                 VB_LAG_ARGS
-                 VB_TRI_ARGS);
+                 VB_LAG_ARGS VB_TRI_ARGS);
 #endif
 }
 

@@ -28,11 +28,12 @@ inline real spring_end(int law, global const real* mat, real k, real len, real r
 // Heun's predicted stage packed (VB_PRED_PACKED; Simulator::pred_packed_): its u array holds
 // (ũx, ũy, ũz, ṽx) and its v array's first half (ṽy, ṽz) as real2, so a warp's read of a
 // neighbour's state touches 4 + 2 cache lines instead of 4 + 4: the reads cost by the lines they
-// touch (1.5M cube, H200: the step 10-12% shorter; docs/PERF_NOTES.md change 27). The inverse mass
-// is not in it: it stays in the state's u.w (w_of), which no stage changes (heun_correct writes
-// each u[e] back with the same w, so a neighbour reads the same inverse mass before or after).
-// `packed` is a constant at every call (0: the stage as two real4 arrays). Only the host's plain
-// case uses it: one work-item per element, no step list, nothing else reading the stage.
+// touch (H200: heun_correct 10% shorter, the 1.5M cube's step 3-5%, 512k's 7%; docs/
+// PERF_NOTES.md change 27). The inverse mass is not in it: it stays in the state's u.w (w_of),
+// which no stage changes (heun_correct writes each u[e] back with the same w, so a neighbour reads
+// the same inverse mass before or after). `packed` is a constant at every call (0: the stage as
+// two real4 arrays). Only the host's plain case uses it: one work-item per element, no step list,
+// nothing else reading the stage.
 #ifndef VB_PRED_PACKED
 #define VB_PRED_PACKED 0
 #endif

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -69,7 +70,8 @@ std::vector<double> run(const Scene& s, bool uniform, int packed = -1) {
   const std::unique_ptr<Simulator> made = [&] {
     const test::ScopedEnv path("VOXBREAST_UNIFORM_PATH", uniform ? "1" : "0");
     const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");  // GPUs: no short loop in the one-launch step
-    const test::ScopedEnv pack("VOXBREAST_PRED_PACKED", packed == 1 ? "1" : "0");
+    std::optional<test::ScopedEnv> pack;
+    if (packed >= 0) pack.emplace("VOXBREAST_PRED_PACKED", packed == 1 ? "1" : "0");
     const test::ScopedEnv lanes("VOXBREAST_LANES", "0");  // CPUs, float: the lanes kernels have no short loop
     return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
   }();
