@@ -342,7 +342,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     const std::size_t real_size = c.precision == Precision::Double ? 8 : 4;
     // one stage for Euler, and for relaxation with the element's mass scale
     const bool heun = c.integrator == "heun";
-    const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, c.law, heun && sim.pred_packed()) +
+    const double bytes = (heun ? 1.0 : 0.5) * heun_bytes_per_element(real_size, c.law, sim.pred_packed()) +
                          (c.integrator == "relaxation" ? double(real_size) : 0.0);
     const double effective = bytes * double(n_free) * sps;
     const char* prec = c.precision == Precision::Double ? "double" : "float";

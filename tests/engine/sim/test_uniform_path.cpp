@@ -63,18 +63,23 @@ TEST(UniformNeighbourhood, MarksElementsWhoseNeighboursShareModulusAndMass) {
   EXPECT_LT(grouped_count, count);  // blocks that mix the two kinds lose their marks
 }
 
+/// A simulator of model m with the short loop on or off and Heun's predicted stage packed (1),
+/// not (0) or by default (-1); neither the one-launch step (GPUs) nor the lanes kernels (CPUs,
+/// float) have the short loop, so both are off.
+std::unique_ptr<Simulator> make_simulator(const Scene& s, const test::Model& m, bool uniform, int packed) {
+  const test::ScopedEnv path("VOXBREAST_UNIFORM_PATH", uniform ? "1" : "0");
+  const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");
+  const test::ScopedEnv lanes("VOXBREAST_LANES", "0");
+  std::optional<test::ScopedEnv> pack;
+  if (packed >= 0) pack.emplace("VOXBREAST_PRED_PACKED", packed == 1 ? "1" : "0");
+  return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
+}
+
 /// u then v after 300 steps from rest (checks every 100: relaxation sets its damping there).
-/// `packed`: Heun's predicted stage packed (1) or not (0), asked for and expected; -1: the default.
+/// `packed`: as make_simulator's, and when asked for, expected.
 std::vector<double> run(const Scene& s, bool uniform, int packed = -1) {
   const test::Model m = test::make_model(s);
-  const std::unique_ptr<Simulator> made = [&] {
-    const test::ScopedEnv path("VOXBREAST_UNIFORM_PATH", uniform ? "1" : "0");
-    const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");  // GPUs: no short loop in the one-launch step
-    std::optional<test::ScopedEnv> pack;
-    if (packed >= 0) pack.emplace("VOXBREAST_PRED_PACKED", packed == 1 ? "1" : "0");
-    const test::ScopedEnv lanes("VOXBREAST_LANES", "0");  // CPUs, float: the lanes kernels have no short loop
-    return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
-  }();
+  const std::unique_ptr<Simulator> made = make_simulator(s, m, uniform, packed);
   Simulator& sim = *made;
   EXPECT_EQ(sim.uniform_path(), uniform);
   if (packed >= 0) EXPECT_EQ(sim.pred_packed(), packed == 1);
@@ -133,10 +138,7 @@ TEST(UniformPath, PackedPredictedStageChangesNoBit) {
 TEST(UniformPath, PredictedStageStaysUnpackedWhereOthersReadIt) {
   const auto packed = [](const Scene& s, bool uniform) {
     const test::Model m = test::make_model(s);
-    const test::ScopedEnv path("VOXBREAST_UNIFORM_PATH", uniform ? "1" : "0");
-    const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");
-    const test::ScopedEnv pack("VOXBREAST_PRED_PACKED", "1");
-    return Simulator(s, m.lattice, m.elements, test::cl_context()).pred_packed();
+    return make_simulator(s, m, uniform, 1)->pred_packed();
   };
   EXPECT_TRUE(packed(test::mixed_block(Integrator::Heun, false), true));
   EXPECT_FALSE(packed(test::mixed_block(Integrator::Heun, true), true));
