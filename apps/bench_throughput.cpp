@@ -365,7 +365,9 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                           {"uniform_loop_elements", sim.uniform_elements()},
                           {"step_list", sim.step_list()},
                           // Heun's predicted stage packed (PERF_NOTES.md change 27)
-                          {"pred_packed", sim.pred_packed()}};
+                          {"pred_packed", sim.pred_packed()},
+                          // the stepping kernels' work-group size, 0: the device's choice (change 28)
+                          {"step_work_group", sim.step_work_group()}};
     csv << c.name << "," << n << "," << c.law << "," << c.integrator << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
         << "," << n_free << "\n";

@@ -10,6 +10,7 @@
 #include "engine/error.hpp"
 #include "engine/sim/kernel_tables.hpp"
 #include "engine/sim/step_list_rule.hpp"
+#include "engine/sim/step_work_group.hpp"
 #include "engine/sim/triangle_contact.hpp"
 #include "engine/sim/uniform_neighbourhood.hpp"
 #include "engine/surface/enclosed_volume.hpp"
@@ -321,12 +322,18 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_VOLUME_LAG=" + std::to_string(volume_lag_);
   options += " -DVB_STRESS_PAIR=" + std::to_string(stress_pair_);
   {
+    // One work-item per element (or listed element) in groups of default_step_work_group on GPUs
+    // (step_work_group.hpp: 256 from 131,072 elements); PoCL picks its own unless
+    // VOXBREAST_STEP_WG asks (not for the lanes kernels, make_lane_args: their own range).
     const std::size_t per = kSplitWorkGroup / std::size_t(force_split_);
-    const std::size_t wg = kCheckWorkGroup;
+    std::size_t wg = cl.info.is_gpu ? default_step_work_group(n_) : 0;
+    if (const char* env = std::getenv("VOXBREAST_STEP_WG"); env && force_split_ == 1 && !lanes_)
+      wg = step_work_group_override(env, cl.info.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>());
+    const std::size_t items = step_list_ ? std::max<std::size_t>(1, step_list_n_) : n_, rounding = wg ? wg : kCheckWorkGroup;
     step_global_ = force_split_ > 1 ? cl::NDRange((n_ + per - 1) / per * kSplitWorkGroup)
-                   : step_list_     ? cl::NDRange(std::max<std::size_t>(1, (step_list_n_ + wg - 1) / wg) * wg)
-                                    : global_;
-    step_local_ = force_split_ > 1 ? cl::NDRange(kSplitWorkGroup) : local_;
+                                    : cl::NDRange((items + rounding - 1) / rounding * rounding);
+    step_local_ = force_split_ > 1 ? cl::NDRange(kSplitWorkGroup) : wg ? cl::NDRange(wg) : cl::NullRange;
+    step_work_group_ = force_split_ > 1 ? kSplitWorkGroup : wg;
   }
   const bool friction = std::any_of(scene.tori.begin(), scene.tori.end(), [](const TorusSpec& t) { return t.friction > 0; }) ||
                         std::any_of(scene.indenters.begin(), scene.indenters.end(),

@@ -1,0 +1,26 @@
+#pragma once
+/// Work-items per group of the stepping kernels on GPUs where each work-item steps one element or
+/// one listed element (kernels/integrate.cl, relax.cl; not the split force pass, the one-launch step
+/// or the CPU lanes kernels, which have their own): 256 from 131,072 elements, 128 below. Measured
+/// on the H200 (docs/PERF_NOTES.md change 28): groups of 256 took 10–12% off the Heun step of the
+/// 1.5M and 4.1M linear cubes, 4–5% off 512k and 2–4% off 262k (springs, neo-Hookean and Ogden,
+/// with and without the volume constraint), 8% off the 1.5M phantom (step list) and 3–5% off the
+/// 500k phantom (Heun, symplectic Euler, relaxation); below, level within the noise (the 64k cube
+/// +1%, the 120k phantom −2% to +1%). 512 lost at 512k and 1,024 everywhere. A group of consecutive
+/// elements spans more rows of the lattice, whose neighbours its warps then share in L1.
+#include <cstddef>
+
+namespace vb {
+
+constexpr std::size_t kStepWorkGroup = 128, kStepWorkGroupLarge = 256, kStepWorkGroupLargeFrom = 131072;
+
+constexpr std::size_t default_step_work_group(std::size_t elements) {
+  return elements >= kStepWorkGroupLargeFrom ? kStepWorkGroupLarge : kStepWorkGroup;
+}
+
+/// The group size VOXBREAST_STEP_WG asks for (to compare sizes on a device), checked: a multiple of
+/// 32 (the marks of the short connection loop are whole warps) within what the device allows.
+/// Throws vb::Error naming the problem otherwise.
+std::size_t step_work_group_override(const char* text, std::size_t device_max);
+
+}  // namespace vb

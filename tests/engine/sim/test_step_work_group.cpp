@@ -1,0 +1,103 @@
+// The stepping kernels' work-group size (engine/sim/step_work_group.hpp; VOXBREAST_STEP_WG forces
+// it here): each element's arithmetic does not depend on which group steps it, so groups of 32 and
+// 256 must agree to the bit, with and without the step list and the volume constraint, for every
+// integrator, springs and a hyperelastic law.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/error.hpp"
+#include "engine/sim/simulator.hpp"
+#include "engine/sim/step_work_group.hpp"
+#include "tests/engine/sim/sim_fixtures.hpp"
+
+namespace vb {
+namespace {
+
+/// u then v after 150 steps with the stepping kernels in groups of `wg` work-items.
+std::vector<double> run(const Scene& s, const char* wg, bool listed) {
+  const test::Model m = test::make_model(s);
+  const std::unique_ptr<Simulator> made = [&] {
+    const test::ScopedEnv size("VOXBREAST_STEP_WG", wg);
+    const test::ScopedEnv list("VOXBREAST_STEP_LIST", listed ? "1" : "0");
+    const test::ScopedEnv lanes("VOXBREAST_LANES", "0");            // CPUs: the lanes kernels keep their own range
+    const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");  // GPUs: nor the one-launch step
+    const test::ScopedEnv split("VOXBREAST_FORCE_SPLIT", "1");      // GPUs: nor the split force pass
+    return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
+  }();
+  Simulator& sim = *made;
+  EXPECT_EQ(sim.step_work_group(), std::size_t(std::stoi(wg)));
+  EXPECT_EQ(sim.step_list(), listed);
+  sim.advance(150);
+  EXPECT_EQ(sim.check().nonfinite_elements, 0);
+  std::vector<double> u, v;
+  sim.download(u, v);
+  u.insert(u.end(), v.begin(), v.end());
+  return u;
+}
+
+std::size_t differing(const std::vector<double>& a, const std::vector<double>& b) {
+  EXPECT_EQ(a.size(), b.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) differ += a[i] != b[i];
+  return differ;
+}
+
+TEST(StepWorkGroup, GroupSizeChangesNoBit) {
+  for (const Integrator integrator : {Integrator::Heun, Integrator::SymplecticEuler, Integrator::Relaxation})
+    for (const bool volume : {false, true})
+      for (const bool listed : {false, true}) {
+        const Scene s = test::mixed_block(integrator, volume);
+        const std::vector<double> small = run(s, "32", listed), large = run(s, "256", listed);
+        EXPECT_EQ(differing(small, large), 0u)
+            << "integrator " << int(integrator) << (volume ? ", volume" : "") << (listed ? ", list" : "");
+      }
+}
+
+TEST(StepWorkGroup, GroupSizeChangesNoBitHyperelastic) {
+  Scene s = test::mixed_block(Integrator::Heun, false);
+  for (auto& [name, material] : s.materials) {
+    const MaterialSpec neo = test::validation_material("neo-hookean", 0.45);
+    material.law = neo.law;
+    material.poisson_ratio = neo.poisson_ratio;
+  }
+  EXPECT_EQ(differing(run(s, "32", false), run(s, "256", false)), 0u);
+}
+
+// 256 from 131,072 elements (H200: 2–12% from 262k up, level below; PERF_NOTES.md change 28).
+TEST(StepWorkGroup, DefaultRuleTakesLargerGroupsForLargeModels) {
+  EXPECT_EQ(default_step_work_group(36000), 128u);
+  EXPECT_EQ(default_step_work_group(131071), 128u);
+  EXPECT_EQ(default_step_work_group(131072), 256u);
+  EXPECT_EQ(default_step_work_group(1520875), 256u);
+}
+
+TEST(StepWorkGroup, OverrideNamesTheVariableAndTheLimits) {
+  EXPECT_EQ(step_work_group_override("64", 1024), 64u);
+  EXPECT_EQ(step_work_group_override("1024", 1024), 1024u);
+  for (const char* bad : {"100", "0", "16", "2048", "256x", "", "-256", "abc"}) {
+    try {
+      step_work_group_override(bad, 1024);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("VOXBREAST_STEP_WG"), std::string::npos) << what;
+      EXPECT_NE(what.find("multiple of 32"), std::string::npos) << what;
+      EXPECT_NE(what.find("1024"), std::string::npos) << what;
+    }
+  }
+}
+
+TEST(StepWorkGroup, SimulatorRefusesABadOverride) {
+  const Scene s = test::mixed_block(Integrator::Heun, false);
+  const test::Model m = test::make_model(s);
+  const test::ScopedEnv size("VOXBREAST_STEP_WG", "48");
+  const test::ScopedEnv lanes("VOXBREAST_LANES", "0");
+  const test::ScopedEnv split("VOXBREAST_FORCE_SPLIT", "1");
+  EXPECT_THROW(Simulator(s, m.lattice, m.elements, test::cl_context()), Error);
+}
+
+}  // namespace
+}  // namespace vb
