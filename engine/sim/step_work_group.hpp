@@ -6,8 +6,9 @@
 /// 1.5M and 4.1M linear cubes, 4–5% off 512k and 2–4% off 262k (springs, neo-Hookean and Ogden,
 /// with and without the volume constraint), 8% off the 1.5M phantom (step list) and 3–5% off the
 /// 500k phantom (Heun, symplectic Euler, relaxation); below, level within the noise (the 64k cube
-/// +1%, the 120k phantom −2% to +1%). 512 lost at 512k and 1,024 everywhere. A group of consecutive
-/// elements spans more rows of the lattice, whose neighbours its warps then share in L1.
+/// +1%, the 120k phantom −2% to +1%). 512 lost at 512k and 1,024 everywhere. Presumably a group's
+/// warps, resident on one SM together, share in its L1 the neighbour rows of the ~2 lattice rows
+/// of consecutive elements a group of 256 spans (not profiled: no profiler on the device machine).
 #include <cstddef>
 
 namespace vb {
