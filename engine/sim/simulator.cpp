@@ -329,11 +329,10 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     std::size_t wg = cl.info.is_gpu ? default_step_work_group(n_) : 0;
     if (const char* env = std::getenv("VOXBREAST_STEP_WG"); env && force_split_ == 1 && !lanes_)
       wg = step_work_group_override(env, cl.info.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>());
-    const std::size_t items = step_list_ ? std::max<std::size_t>(1, step_list_n_) : n_, rounding = wg ? wg : kCheckWorkGroup;
+    const std::size_t items = step_list_ ? std::max<std::size_t>(1, step_list_n_) : n_, rounding = wg ? wg : kStepWorkGroup;
     step_global_ = force_split_ > 1 ? cl::NDRange((n_ + per - 1) / per * kSplitWorkGroup)
                                     : cl::NDRange((items + rounding - 1) / rounding * rounding);
     step_local_ = force_split_ > 1 ? cl::NDRange(kSplitWorkGroup) : wg ? cl::NDRange(wg) : cl::NullRange;
-    step_work_group_ = force_split_ > 1 ? kSplitWorkGroup : wg;
   }
   const bool friction = std::any_of(scene.tori.begin(), scene.tori.end(), [](const TorusSpec& t) { return t.friction > 0; }) ||
                         std::any_of(scene.indenters.begin(), scene.indenters.end(),

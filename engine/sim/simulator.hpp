@@ -168,7 +168,7 @@ class Simulator {
   /// Whether the stepping kernels run over a list of the free elements (GPUs; kernels/integrate.cl).
   bool step_list() const { return step_list_; }
   /// Work-items per group of the stepping kernels (step_work_group.hpp); 0: the device picks (PoCL).
-  std::size_t step_work_group() const { return step_work_group_; }
+  std::size_t step_work_group() const { return step_local_.dimensions() ? step_local_[0] : 0; }
   /// The volume constraint's scalars as the last kernel left them (kernels/volume.cl; lattice
   /// frame): the last correction's λ (m³ per unit w|g|²) and μ, the last sums' volume V (m³) and
   /// pressure p (Pa, computed by check()), and the lagged multiplier M (Pa·s: M/dt is the pressure
@@ -340,7 +340,6 @@ class Simulator {
   cl::Buffer free_list_;
   /// the stepping kernels (Heun's VB_SPLIT; lanes and the step list: the free elements)
   cl::NDRange step_global_, step_local_;
-  std::size_t step_work_group_ = 0;  ///< step_local_'s size, 0 for NullRange
   cl::Buffer vol_grad_pred_, vol_scalars_pred_, vol_no_scalars_;
   cl::Kernel vol_pending_;
   bool volume_ = false;

@@ -10,6 +10,7 @@
 #include "engine/scene/scene.hpp"
 #include "engine/sim/element_setup.hpp"
 #include "engine/sim/opencl_runtime.hpp"
+#include "engine/sim/simulator.hpp"
 
 namespace vb::test {
 
@@ -147,6 +148,21 @@ inline Model make_model(const Scene& s) {
   m.lattice = build_lattice(voxelise_shapes(s), s.model.downsample);
   m.elements = make_element_arrays(s, m.lattice);
   return m;
+}
+
+/// Every element's u then v as the simulator holds them now: one vector, for comparisons to the bit.
+inline std::vector<double> state_uv(Simulator& sim) {
+  std::vector<double> u, v;
+  sim.download(u, v);
+  u.insert(u.end(), v.begin(), v.end());
+  return u;
+}
+
+/// How many values of a and b differ (compared to the bit; over the shorter, the caller checks sizes).
+inline std::size_t differing_values(const std::vector<double>& a, const std::vector<double>& b) {
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) differ += a[i] != b[i];
+  return differ;
 }
 
 }  // namespace vb::test

@@ -38,9 +38,7 @@ std::vector<double> run(const Scene& s, bool listed) {
   sim.upload(u, v);
   sim.advance(100);
   EXPECT_EQ(sim.check().nonfinite_elements, 0);
-  sim.download(u, v);
-  u.insert(u.end(), v.begin(), v.end());
-  return u;
+  return test::state_uv(sim);
 }
 
 TEST(StepList, MatchesEveryElementsLaunchToTheBit) {
@@ -49,9 +47,7 @@ TEST(StepList, MatchesEveryElementsLaunchToTheBit) {
       const Scene s = test::mixed_block(integrator, volume);
       const std::vector<double> all = run(s, false), listed = run(s, true);
       ASSERT_EQ(all.size(), listed.size());
-      std::size_t differ = 0;
-      for (std::size_t i = 0; i < all.size(); ++i) differ += all[i] != listed[i];
-      EXPECT_EQ(differ, 0u) << "integrator " << int(integrator) << (volume ? ", volume" : "");
+      EXPECT_EQ(test::differing_values(all, listed), 0u) << "integrator " << int(integrator) << (volume ? ", volume" : "");
     }
 }
 

@@ -32,17 +32,12 @@ std::vector<double> run(const Scene& s, const char* wg, bool listed) {
   EXPECT_EQ(sim.step_list(), listed);
   sim.advance(150);
   EXPECT_EQ(sim.check().nonfinite_elements, 0);
-  std::vector<double> u, v;
-  sim.download(u, v);
-  u.insert(u.end(), v.begin(), v.end());
-  return u;
+  return test::state_uv(sim);
 }
 
 std::size_t differing(const std::vector<double>& a, const std::vector<double>& b) {
   EXPECT_EQ(a.size(), b.size());
-  std::size_t differ = 0;
-  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) differ += a[i] != b[i];
-  return differ;
+  return test::differing_values(a, b);
 }
 
 TEST(StepWorkGroup, GroupSizeChangesNoBit) {

@@ -94,10 +94,7 @@ std::vector<double> run(const Scene& s, bool uniform, int packed = -1) {
     sim.advance(100);
     EXPECT_EQ(sim.check().nonfinite_elements, 0);
   }
-  std::vector<double> u, v;
-  sim.download(u, v);
-  u.insert(u.end(), v.begin(), v.end());
-  return u;
+  return test::state_uv(sim);
 }
 
 // In double the two loops differ only in rounding (κ·h·E against the harmonic mean 2E²/(2E),
@@ -127,9 +124,7 @@ TEST(UniformPath, PackedPredictedStageChangesNoBit) {
     double moved = 0;  // the block sags under gravity: the comparison is of a motion
     for (double x : plain) moved = std::max(moved, std::abs(x));
     EXPECT_GT(moved, 1e-5);
-    std::size_t differing = 0;
-    for (std::size_t i = 0; i < plain.size(); ++i) differing += packed[i] != plain[i];
-    EXPECT_EQ(differing, 0u) << (precision == Precision::Float ? "float" : "double");
+    EXPECT_EQ(test::differing_values(packed, plain), 0u) << (precision == Precision::Float ? "float" : "double");
   }
 }
 
