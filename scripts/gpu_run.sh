@@ -13,7 +13,7 @@ case "${1:-}" in
     build=${VOXBREAST_BUILD_DIR:-$root/build}
     rm -rf "$pkgs" && mkdir -p "$pkgs/bin" "$pkgs/lib" "$pkgs/deb"
     cp "$build/apps/voxbreast" "$build/tests/test_physics" "$pkgs/bin/"
-    for t in test_fit test_probing; do  # batched fit solves; triangle contact
+    for t in test_fit test_probing test_force_feedback; do  # every test binary that runs OpenCL
       if [[ -x "$build/tests/$t" ]]; then cp "$build/tests/$t" "$pkgs/bin/"; fi
     done
     # Every shared library the binary needs except the C runtime the device already has.

@@ -6,9 +6,9 @@
 /// 1.5M and 4.1M linear cubes, 4–5% off 512k and 2–4% off 262k (springs, neo-Hookean and Ogden,
 /// with and without the volume constraint), 8% off the 1.5M phantom (step list) and 3–5% off the
 /// 500k phantom (Heun, symplectic Euler, relaxation); below, level within the noise (the 64k cube
-/// +1%, the 120k phantom −2% to +1%). 512 lost at 512k and 1,024 everywhere. Presumably a group's
-/// warps, resident on one SM together, share in its L1 the neighbour rows of the ~2 lattice rows
-/// of consecutive elements a group of 256 spans (not profiled: no profiler on the device machine).
+/// +1%, the 120k phantom −2% to +1%). 512 lost at 512k and 1,024 everywhere. Why is not known (no
+/// profiler on the device machine): not the neighbour rows a group shares in its SM's L1, since
+/// groups shaped as tiles with half the footprint gained at most 2.6% (PERF_NOTES.md attempt 33).
 #include <cstddef>
 
 namespace vb {
