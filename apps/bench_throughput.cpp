@@ -366,6 +366,8 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                           {"step_list", sim.step_list()},
                           // Heun's predicted stage packed (PERF_NOTES.md change 27)
                           {"pred_packed", sim.pred_packed()},
+                          // Heun's corrector over the blocks last to first (change 29)
+                          {"correct_reverse", sim.correct_reverse()},
                           // the stepping kernels' work-group size, 0: the device's choice (change 28)
                           {"step_work_group", sim.step_work_group()}};
     csv << c.name << "," << n << "," << c.law << "," << c.integrator << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","

@@ -274,6 +274,28 @@ kernel VB_STEP_ATTR void heun_predict(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PA
                   VB_FOLD_PENDING(state), VB_LAG_KERNEL_ARGS, share VB_TRI_ARGS);
 }
 
+// VB_CORRECT_REVERSE (Simulator::correct_reverse_, engine/sim/correct_order.hpp): heun_correct
+// takes the elements' aligned blocks of VB_REVERSE_BLOCK (the short loop's lockstep, so a warp
+// still holds one block of marks) from the last to the first, each block in order. It then starts
+// on the lines heun_predict wrote last, presumably still in L2, and ends on the elements the next
+// heun_predict starts with (H200, linear cubes of 1.0M-1.5M elements: 4-5% more steps/s; docs/
+// PERF_NOTES.md change 29). Each element's arithmetic is its own, so the order changes no result.
+#ifndef VB_CORRECT_REVERSE
+#define VB_CORRECT_REVERSE 0
+#endif
+#if VB_CORRECT_REVERSE
+#if VB_SPLIT > 1 || VB_STEP_LIST || VB_LANES || VB_PERSISTENT
+#error "VB_CORRECT_REVERSE: one work-item per element, in the elements' own order, only"
+#endif
+inline uint reverse_block_element(uint i, uint n) {
+  const uint blocks = (n + VB_REVERSE_BLOCK - 1) / VB_REVERSE_BLOCK, b = i / VB_REVERSE_BLOCK;
+  return b < blocks ? (blocks - 1 - b) * VB_REVERSE_BLOCK + i % VB_REVERSE_BLOCK : UINT_MAX;
+}
+#define VB_CORRECT_ELEMENT reverse_block_element(get_global_id(0), n)
+#else
+#define VB_CORRECT_ELEMENT VB_STEP_ELEMENT
+#endif
+
 // heun_correct reads the predicted stage from u_out_at, v_out_at and writes u, v.
 kernel VB_STEP_ATTR void heun_correct(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
                                       uint n VB_FOLD_PARAMS(state) VB_FOLD_PARAMS(pred) VB_TRI_PARAMS
@@ -281,6 +303,6 @@ kernel VB_STEP_ATTR void heun_correct(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PA
   VB_UNPACK_LATTICE;
   VB_UNPACK_STEP_STATE(, const);
   VB_STEP_SHARE;
-  correct_element(VB_STEP_ELEMENT, u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, VB_STEP_N,
+  correct_element(VB_CORRECT_ELEMENT, u, v, u_out, v_out, VB_LATTICE_ARGS, VB_INDENTER_ARGS, dt, VB_STEP_N,
                   VB_FOLD_PENDING(state), VB_FOLD_PENDING(pred), share VB_TRI_ARGS);
 }

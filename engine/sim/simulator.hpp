@@ -165,6 +165,9 @@ class Simulator {
   std::size_t uniform_elements() const { return uniform_elements_; }
   /// Whether Heun's predicted stage is stored packed (ũ, ṽx | ṽy, ṽz; kernels/lattice_forces.cl).
   bool pred_packed() const { return pred_packed_; }
+  /// Whether Heun's corrector steps the elements' blocks from the last to the first
+  /// (engine/sim/correct_order.hpp).
+  bool correct_reverse() const { return correct_reverse_; }
   /// Whether the stepping kernels run over a list of the free elements (GPUs; kernels/integrate.cl).
   bool step_list() const { return step_list_; }
   /// Work-items per group of the stepping kernels (step_work_group.hpp); 0: the device picks (PoCL).
@@ -353,6 +356,7 @@ class Simulator {
   bool uniform_path_ = false;  ///< linear springs: uniform neighbourhoods marked, their short loop compiled in
   std::size_t uniform_elements_ = 0;  ///< elements marked
   bool pred_packed_ = false;  ///< Heun's predicted stage packed (VB_PRED_PACKED)
+  bool correct_reverse_ = false;  ///< heun_correct over the blocks last to first (VB_CORRECT_REVERSE)
   DeviceArena vol_mesh_;  ///< triangles, surface elements, incident start, incident (kernels/volume.cl)
   cl_uint4 vol_mesh_at_{};
   cl::Buffer vol_grad_, vol_partial_,

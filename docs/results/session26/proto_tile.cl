@@ -9,8 +9,15 @@
 // The state stays in row order in every case: only which elements a group takes together changes,
 // so a group's neighbour rows (its L1 footprint) shrink from ~4.2 × 3 rows to (TY + 2) × (TZ + 2)
 // row pieces of TX + 2.
+// REVERSE (ORDER 0; PROTO_REVERSE=1 sets it for the second stage, attempt 35): the stage steps the
+// elements from the last to the first, so it starts where the first stage ended, on the lines
+// most recently written (the predicted stage still in L2), and ends where the next step's first
+// stage starts.
 #ifndef ORDER
 #define ORDER 0
+#endif
+#ifndef REVERSE
+#define REVERSE 0
 #endif
 #ifndef LAYOUT
 #define LAYOUT 0
@@ -64,7 +71,10 @@ inline void store(int L, global float* s, int e, uint n, float3 u, float3 v) {
 kernel void stage(global const float* src, global const float* base, global float* out, global const float* W,
                   global const float* E, global const int* grid, global const uint* cell_of, global const uint* L,
                   int sy, int sz, float h, float dt, float zeta, int second, uint n) {
-#if ORDER == 0
+#if ORDER == 0 && REVERSE  // the elements in reverse order (PROTO_REVERSE: the second stage)
+  if (get_global_id(0) >= n) return;
+  const uint e = n - 1 - get_global_id(0);
+#elif ORDER == 0
   const uint e = get_global_id(0);
   if (e >= n) return;
 #elif ORDER == 1 || ORDER == 2

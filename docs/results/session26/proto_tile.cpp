@@ -152,7 +152,9 @@ int main(int argc, char** argv) {
     const std::string dims = " -DORDER=" + std::to_string(c.order) + " -DNC=" + std::to_string(N) + "u -DTX=" + std::to_string(std::max(1, c.tx)) +
                              "u -DTY=" + std::to_string(std::max(1, c.ty)) + "u -DTZ=" + std::to_string(std::max(1, c.tz)) + "u";
     cl_program p = build(base_opts + "-DLAYOUT=0 -DLOUT=1" + dims);
-    cl_program p2 = build(base_opts + "-DLAYOUT=0 -DLSRC=1" + dims);
+    // PROTO_REVERSE=1 (attempt 35): the second stage steps the elements in reverse order
+    const bool reverse = std::getenv("PROTO_REVERSE") && std::atoi(std::getenv("PROTO_REVERSE"));
+    cl_program p2 = build(base_opts + "-DLAYOUT=0 -DLSRC=1" + dims + (reverse ? " -DREVERSE=1" : ""));
     cl_kernel k1 = clCreateKernel(p, "stage", &err); CK(err);
     cl_kernel k2 = clCreateKernel(p2, "stage", &err); CK(err);
     size_t gs = (n + wg - 1) / wg * wg;
@@ -197,6 +199,8 @@ int main(int argc, char** argv) {
       if (!ref.empty()) diff = std::max(diff, std::fabs(double(uo[3 * e + c]) - ref[3 * e + c]));
     }
     if (ref.empty()) ref = uo;
+    double checksum = 0;  // to compare runs of separate processes (the environment's variants)
+    for (size_t i = 0; i < uo.size(); ++i) checksum += double(uo[i]) * double(1 + i % 1013);
     for (int s = 0; s < 50; ++s) step();
     CK(clFinish(q));
     double bestt = 1e9;
@@ -221,9 +225,10 @@ int main(int argc, char** argv) {
       clReleaseEvent(evs[i]);
     }
     if (inplace) std::printf("in place  ");
+    if (reverse) std::printf("reverse  ");
     std::printf("order %d tile %3d x %2d x %2d wg %3zu  stage1 %6.1f us  stage2 %6.1f us  ", c.order, c.tx, c.ty, c.tz, wg, st[0], st[1]);
-    std::printf("layout %d  steps/s %8.0f  us/step %7.1f  %%bw(184B) %5.1f  moved %.3g  diff %.3g  %s\n", layout, sps,
-                1e6 / sps, 100 * sps * 184.0 * n / bw, scale, diff, finite ? "finite" : "NONFINITE");
+    std::printf("layout %d  steps/s %8.0f  us/step %7.1f  %%bw(184B) %5.1f  moved %.3g  diff %.3g  checksum %.17g  %s\n", layout, sps,
+                1e6 / sps, 100 * sps * 184.0 * n / bw, scale, diff, checksum, finite ? "finite" : "NONFINITE");
     std::fflush(stdout);
     for (cl_mem x : m) clReleaseMemObject(x);
     clReleaseMemObject(bM);
