@@ -107,6 +107,18 @@ inline MaterialSpec validation_material(const std::string& law, double nu) {
   return m;
 }
 
+/// mixed_block(Heun) with every tissue on the neo-Hookean law (ν = 0.45), each keeping its E and
+/// density: the hyperelastic passes on the same kinds of neighbour.
+inline Scene neo_hookean_mixed_block() {
+  Scene s = mixed_block(Integrator::Heun, false);
+  for (auto& [name, material] : s.materials) {
+    const MaterialSpec neo = validation_material("neo-hookean", 0.45);
+    material.law = neo.law;
+    material.poisson_ratio = neo.poisson_ratio;
+  }
+  return s;
+}
+
 /// Two plates through the centres of the bottom and top layers of an n-layer box of spacing h
 /// (so the gap is (n − 1)·h); the top one moves by (stretch − 1)·gap along z at `speed` and stops.
 inline std::vector<IndenterSpec> plate_pair(int n, double h, double stretch,

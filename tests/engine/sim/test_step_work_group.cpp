@@ -52,12 +52,7 @@ TEST(StepWorkGroup, GroupSizeChangesNoBit) {
 }
 
 TEST(StepWorkGroup, GroupSizeChangesNoBitHyperelastic) {
-  Scene s = test::mixed_block(Integrator::Heun, false);
-  for (auto& [name, material] : s.materials) {
-    const MaterialSpec neo = test::validation_material("neo-hookean", 0.45);
-    material.law = neo.law;
-    material.poisson_ratio = neo.poisson_ratio;
-  }
+  const Scene s = test::neo_hookean_mixed_block();
   EXPECT_EQ(differing(run(s, "32", false), run(s, "256", false)), 0u);
 }
 
