@@ -26,6 +26,16 @@ struct ScopedEnv {
   const char* name_;
 };
 
+/// For its lifetime, the stepping kernels of a new simulator are the real4 kernels with one
+/// work-item per element (or listed element), in the elements' order: not the CPU lanes kernels,
+/// the one-launch step (GPUs) or the split force pass (GPUs, hyperelastic), each of which keeps its
+/// own range, order and list.
+struct OneItemPerElement {
+  ScopedEnv lanes{"VOXBREAST_LANES", "0"};
+  ScopedEnv one_launch{"VOXBREAST_PERSISTENT", "0"};
+  ScopedEnv split{"VOXBREAST_FORCE_SPLIT", "1"};
+};
+
 /// The default device (PoCL in CI), created once.
 inline const ClContext& cl_context() {
   static const std::unique_ptr<ClContext> cl = std::make_unique<ClContext>(select_device(""));

@@ -19,9 +19,7 @@ std::unique_ptr<Simulator> make(const Scene& s, const test::Model& m, bool rever
   const test::ScopedEnv uniform("VOXBREAST_UNIFORM_PATH", short_loop ? "1" : "0");
   const test::ScopedEnv packed("VOXBREAST_PRED_PACKED", short_loop ? "1" : "0");
   const test::ScopedEnv list("VOXBREAST_STEP_LIST", "0");
-  const test::ScopedEnv lanes("VOXBREAST_LANES", "0");            // CPUs: the lanes kernels keep their own order
-  const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");  // GPUs: nor the one-launch step
-  const test::ScopedEnv split("VOXBREAST_FORCE_SPLIT", "1");      // GPUs: nor the split force pass
+  const test::OneItemPerElement kernels;
   return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
 }
 
@@ -61,9 +59,7 @@ TEST(CorrectOrder, OnlyHeunsCorrectorInElementOrder) {
   {
     const test::ScopedEnv list_on("VOXBREAST_STEP_LIST", "1");
     const test::ScopedEnv order("VOXBREAST_CORRECT_REVERSE", "1");
-    const test::ScopedEnv lanes("VOXBREAST_LANES", "0");
-    const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");
-    const test::ScopedEnv split("VOXBREAST_FORCE_SPLIT", "1");
+    const test::OneItemPerElement kernels;
     EXPECT_FALSE(Simulator(heun, m.lattice, m.elements, test::cl_context()).correct_reverse());
   }
   const Scene euler = test::mixed_block(Integrator::SymplecticEuler, false);

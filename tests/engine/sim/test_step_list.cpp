@@ -24,8 +24,7 @@ std::vector<double> run(const Scene& s, bool listed) {
     const test::ScopedEnv list("VOXBREAST_STEP_LIST", listed ? "1" : "0");
     // the same connection loop in both (GPUs: the short loop is off by default with the list)
     const test::ScopedEnv path("VOXBREAST_UNIFORM_PATH", "0");
-    const test::ScopedEnv lanes("VOXBREAST_LANES", "0");            // CPUs: the real4 kernels, which the list is for
-    const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");  // GPUs: nor is the one-launch step listed
+    const test::OneItemPerElement kernels;  // the real4 kernels, which the list is for
     return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
   }();
   Simulator& sim = *made;

@@ -22,9 +22,7 @@ std::vector<double> run(const Scene& s, const char* wg, bool listed) {
   const std::unique_ptr<Simulator> made = [&] {
     const test::ScopedEnv size("VOXBREAST_STEP_WG", wg);
     const test::ScopedEnv list("VOXBREAST_STEP_LIST", listed ? "1" : "0");
-    const test::ScopedEnv lanes("VOXBREAST_LANES", "0");            // CPUs: the lanes kernels keep their own range
-    const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");  // GPUs: nor the one-launch step
-    const test::ScopedEnv split("VOXBREAST_FORCE_SPLIT", "1");      // GPUs: nor the split force pass
+    const test::OneItemPerElement kernels;
     return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
   }();
   Simulator& sim = *made;
@@ -84,8 +82,7 @@ TEST(StepWorkGroup, SimulatorRefusesABadOverride) {
   const Scene s = test::mixed_block(Integrator::Heun, false);
   const test::Model m = test::make_model(s);
   const test::ScopedEnv size("VOXBREAST_STEP_WG", "48");
-  const test::ScopedEnv lanes("VOXBREAST_LANES", "0");
-  const test::ScopedEnv split("VOXBREAST_FORCE_SPLIT", "1");
+  const test::OneItemPerElement kernels;
   EXPECT_THROW(Simulator(s, m.lattice, m.elements, test::cl_context()), Error);
 }
 

@@ -68,8 +68,7 @@ TEST(UniformNeighbourhood, MarksElementsWhoseNeighboursShareModulusAndMass) {
 /// float) have the short loop, so both are off.
 std::unique_ptr<Simulator> make_simulator(const Scene& s, const test::Model& m, bool uniform, int packed) {
   const test::ScopedEnv path("VOXBREAST_UNIFORM_PATH", uniform ? "1" : "0");
-  const test::ScopedEnv one_launch("VOXBREAST_PERSISTENT", "0");
-  const test::ScopedEnv lanes("VOXBREAST_LANES", "0");
+  const test::OneItemPerElement kernels;
   std::optional<test::ScopedEnv> pack;
   if (packed >= 0) pack.emplace("VOXBREAST_PRED_PACKED", packed == 1 ? "1" : "0");
   return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
