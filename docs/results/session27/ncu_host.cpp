@@ -3,7 +3,7 @@
 // that Nsight Compute, which does not see OpenCL launches, can profile the very same code. A
 // diagnostic only: the product stays OpenCL (no CUDA in the build).
 //   g++ -O2 -I/usr/local/cuda/include ncu_host.cpp -o ncu_host -L/usr/local/cuda/lib64/stubs -lcuda
-//   ncu --set full ./ncu_host stage1.ptx stage2.ptx N STEPS WG
+//   ncu --set full ./ncu_host stage1.ptx stage2.ptx N STEPS WG      (NCU_INPLACE=1: corrector in place)
 #include <cuda.h>
 #include <cstdio>
 #include <cstdlib>
@@ -59,14 +59,16 @@ int main(int argc, char** argv) {
   CUdeviceptr dW = mk(4 * n, W.data()), dE = mk(4 * n, E.data()), dg = mk(4 * grid.size(), grid.data()),
               dc = mk(4 * n, cell.data()), dL = mk(4 * n, cell.data());
   unsigned nn = unsigned(n);
+  const bool inplace = std::getenv("NCU_INPLACE") && std::atoi(std::getenv("NCU_INPLACE"));
   const unsigned blocks = unsigned((n + wg - 1) / wg);
   for (int s = 0; s < steps; ++s)
     for (int stage = 0; stage < 2; ++stage) {
-      CUdeviceptr src = stage ? pred : a, base = a, out = stage ? b : pred;
+      // NCU_INPLACE=1: the corrector writes over the step's base, as main's heun_correct does
+      CUdeviceptr src = stage ? pred : a, base = a, out = stage ? (inplace ? a : b) : pred;
       int second = stage;
       void* args[] = {&src, &base, &out, &dW, &dE, &dg, &dc, &dL, (void*)&sy, (void*)&sz, &h, &dt, &zeta, &second, &nn};
       CK(cuLaunchKernel(k[stage], blocks, 1, 1, wg, 1, 1, 0, nullptr, args, nullptr));
-      if (stage) std::swap(a, b);
+      if (stage && !inplace) std::swap(a, b);
     }
   CK(cuCtxSynchronize());
   std::vector<float> out(4 * n);
