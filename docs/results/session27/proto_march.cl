@@ -198,6 +198,21 @@ inline void centre_store(Centre k, global const float* base, global float* out, 
   }
 }
 
+// centre_load without branches: W and E read for halo centres too (ORDERs 5-7)
+inline Centre centre_load2(global const float* RESTRICT src, global const float* RESTRICT W, global const float* RESTRICT E,
+                           global const int* RESTRICT grid, int c, uint n, float h, float zeta) {
+  Centre k;
+  const int jn = grid[c];
+  k.e = jn;
+  const int j = jn >= 0 ? jn : 0;
+  k.u = load_u(LSRC, src, j, n);
+  k.v = load_v(LSRC, src, j, n);
+  k.f = (float3)(0);
+  k.w = W[j];
+  k.hE = h * E[j];
+  k.damp = 2 * zeta * sqrt(h * E[j] / (2 * k.w));
+  return k;
+}
 // A work-item per column piece: (x, y) and the TZ cells from z0 = TZ·b, consecutive work-items
 // along x (a warp's reads as contiguous as the gather's). It walks the planes p = z0 - 1 … z0 + TZ;
 // plane p's 9 cells serve the centres at p - 1 (offset dz = +1), p (dz = 0) and p + 1 (dz = -1),
@@ -252,20 +267,6 @@ kernel void stage(global const float* src, global const float* base, global floa
 // by multiplication, planes past the piece's end read at its last plane and masked; only the
 // store branches. RESTRICT (PROTO_OPTS -DRESTRICT=restrict) lets the compiler hoist the next
 // plane's reads above a store.
-inline Centre centre_load2(global const float* RESTRICT src, global const float* RESTRICT W, global const float* RESTRICT E,
-                           global const int* RESTRICT grid, int c, uint n, float h, float zeta) {
-  Centre k;
-  const int jn = grid[c];
-  k.e = jn;
-  const int j = jn >= 0 ? jn : 0;
-  k.u = load_u(LSRC, src, j, n);
-  k.v = load_v(LSRC, src, j, n);
-  k.f = (float3)(0);
-  k.w = W[j];
-  k.hE = h * E[j];
-  k.damp = 2 * zeta * sqrt(h * E[j] / (2 * k.w));
-  return k;
-}
 kernel void stage(global const float* RESTRICT src, global const float* RESTRICT base, global float* RESTRICT out,
                   global const float* RESTRICT W, global const float* RESTRICT E, global const int* RESTRICT grid,
                   global const uint* cell_of, global const uint* L, int sy, int sz, float h, float dt, float zeta,
@@ -390,6 +391,119 @@ kernel void stage(global const float* RESTRICT src, global const float* RESTRICT
       if (k < (int)TZ + 1) nxt.f += conn_lean(nxt.u, nxt.v, mn * pq[q] * k1 * nxt.hE, mn * pq[q] * s1 * nxt.damp, uq[q], vq[q], dx, dy, -1, h);
     }
     if (k >= 2 && mp != 0) centre_store(prv, base, out, n, dt, second);
+    prv = cur;
+    cur = nxt;
+  }
+}
+#endif
+
+#if ORDER == 7
+// ORDER 7 (attempt 36f): the lean march over the grid with two adjacent work-items per column
+// piece, so each holds half a plane's cells: the first takes the cells (dx, dy) = (-1..1, -1) and
+// (-1, 0), the second their mirror images (dx, dy) → (-dx, -dy); the centre cell's connection to
+// the centre below goes to the first, to the one above to the second. Each keeps the three
+// centres and a partial force; the stored centre's force is the pair's sum (NV_SHFL: a butterfly
+// shuffle; elsewhere through local memory). Why: ORDER 5 ran latency-bound at 96-110 registers.
+#ifdef NV_SHFL
+inline float xor1(float x) {
+  float r;
+  asm volatile("shfl.sync.bfly.b32 %0, %1, 1, 0x1f, 0xffffffff;" : "=f"(r) : "f"(x));
+  return r;
+}
+#endif
+// conn_lean with the rest vector given (h·d, mirrored for the second work-item)
+inline float3 conn_hd(float3 ui, float3 vi, float kE, float cD, float3 uj, float3 vj, float3 hd, float hdl) {
+  const float3 r = hd + (uj - ui);
+  const float len_sq = dot(r, r);
+  const float inv = rsqrt(fmax(len_sq, 1e-30f));
+  const float s = kE * (len_sq * inv - hdl) + cD * dot(vj - vi, r) * inv;
+  return (s * inv) * r;
+}
+kernel void stage(global const float* RESTRICT src, global const float* RESTRICT base, global float* RESTRICT out,
+                  global const float* RESTRICT W, global const float* RESTRICT E, global const int* RESTRICT grid,
+                  global const uint* cell_of, global const uint* L, int sy, int sz, float h, float dt, float zeta,
+                  int second, uint n) {
+  const uint gid = get_global_id(0);
+  const uint c = gid >> 1;
+  const int second_item = (int)(gid & 1);
+  const int si = second_item ? -1 : 1;
+  const float sgh = second_item ? -h : h;
+  const uint x = c % NC, y = (c / NC) % NC;
+  uint b = c / (NC * NC);
+  const int active = b * TZ < NC;  // padding work-items run a valid piece and store nothing
+  if (!active) b = (NC - 1) / TZ;
+  const int z0 = (int)(b * TZ);
+  const int zend = min((int)NC, z0 + (int)TZ);
+  const int col = (int)(x + 1) + sy * (int)(y + 1) + sz;
+#ifndef NV_SHFL
+  local float xch[3 * 1024];
+  const uint lid = get_local_id(0);
+#endif
+  Centre prv = centre_load2(src, W, E, grid, col + sz * (z0 - 1), n, h, zeta);
+  Centre cur = prv;
+#pragma unroll
+  for (int k = 0; k < (int)TZ + 2; ++k) {
+    const int p = z0 - 1 + k;
+    const int pl = min(p, zend);
+    Centre nxt = centre_load2(src, W, E, grid, col + sz * min(p + 1, zend), n, h, zeta);
+    const float mp = (k >= 2 && p - 1 < zend && prv.e >= 0) ? 1.0f : 0.0f;
+    const float mc = (k >= 1 && p < zend && cur.e >= 0) ? 1.0f : 0.0f;
+    const float mn = (p + 1 < zend && nxt.e >= 0) ? 1.0f : 0.0f;
+    int jq[4];
+    float3 uq[4], vq[4];
+    float pq[4];
+#pragma unroll
+    for (int q = 0; q < 4; ++q) {
+      const int bdx = q < 3 ? q - 1 : -1, bdy = q < 3 ? -1 : 0;
+      jq[q] = grid[col + si * (bdx + sy * bdy) + sz * pl];
+    }
+#pragma unroll
+    for (int q = 0; q < 4; ++q) {
+      const int j = jq[q] >= 0 ? jq[q] : 0;
+      uq[q] = load_u(LSRC, src, j, n);
+      vq[q] = load_v(LSRC, src, j, n);
+      pq[q] = jq[q] >= 0 ? 1.0f : 0.0f;
+    }
+#pragma unroll
+    for (int q = 0; q < 4; ++q) {
+      const int bdx = q < 3 ? q - 1 : -1, bdy = q < 3 ? -1 : 0;
+      const int m0 = abs(bdx) + abs(bdy), m1 = m0 + 1;
+      const float k1 = m1 == 1 ? 0.5f : m1 == 2 ? 0.25f : 0.125f, s1 = m1 == 1 ? 0.70710678f : m1 == 2 ? 0.5f : 0.35355339f;
+      const float l1 = m1 == 1 ? 1.0f : m1 == 2 ? 1.41421356f : 1.73205081f;
+      const float k0 = m0 == 1 ? 0.5f : 0.25f, s0 = m0 == 1 ? 0.70710678f : 0.5f, l0 = m0 == 1 ? 1.0f : 1.41421356f;
+      const float hx = sgh * bdx, hy = sgh * bdy;
+      if (k >= 2)
+        prv.f += conn_hd(prv.u, prv.v, mp * pq[q] * k1 * prv.hE, mp * pq[q] * s1 * prv.damp, uq[q], vq[q],
+                         (float3)(hx, hy, h), h * l1);
+      if (k >= 1)
+        cur.f += conn_hd(cur.u, cur.v, mc * pq[q] * k0 * cur.hE, mc * pq[q] * s0 * cur.damp, uq[q], vq[q],
+                         (float3)(hx, hy, 0), h * l0);
+      if (k < (int)TZ + 1)
+        nxt.f += conn_hd(nxt.u, nxt.v, mn * pq[q] * k1 * nxt.hE, mn * pq[q] * s1 * nxt.damp, uq[q], vq[q],
+                         (float3)(hx, hy, -h), h * l1);
+    }
+    {  // the centre cell: to the centre below (first work-item) or above (second)
+      const float cp = cur.e >= 0 ? 1.0f : 0.0f;
+      const float mt = second_item ? (k < (int)TZ + 1 ? mn : 0.0f) : (k >= 2 ? mp : 0.0f);
+      const float3 tu = second_item ? nxt.u : prv.u, tv = second_item ? nxt.v : prv.v;
+      const float thE = second_item ? nxt.hE : prv.hE, tdamp = second_item ? nxt.damp : prv.damp;
+      const float3 g = conn_hd(tu, tv, mt * cp * 0.5f * thE, mt * cp * 0.70710678f * tdamp, cur.u, cur.v,
+                               (float3)(0, 0, second_item ? -h : h), h);
+      if (second_item) nxt.f += g; else prv.f += g;
+    }
+    if (k >= 2) {  // the pair's sum of the completed centre's force
+#ifdef NV_SHFL
+      const float3 other = (float3)(xor1(prv.f.x), xor1(prv.f.y), xor1(prv.f.z));
+#else
+      barrier(CLK_LOCAL_MEM_FENCE);
+      xch[3 * lid] = prv.f.x; xch[3 * lid + 1] = prv.f.y; xch[3 * lid + 2] = prv.f.z;
+      barrier(CLK_LOCAL_MEM_FENCE);
+      const uint o = lid ^ 1u;
+      const float3 other = (float3)(xch[3 * o], xch[3 * o + 1], xch[3 * o + 2]);
+#endif
+      prv.f += other;
+      if (active && !second_item && mp != 0) centre_store(prv, base, out, n, dt, second);
+    }
     prv = cur;
     cur = nxt;
   }

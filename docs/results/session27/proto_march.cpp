@@ -165,6 +165,7 @@ int main(int argc, char** argv) {
       gs = nt * wg;
     }
     if (c.order >= 4) gs = (size_t(N) * N * ((N + c.tz - 1) / c.tz) + wg - 1) / wg * wg;  // a work-item per column piece
+    if (c.order == 7) gs = (2 * size_t(N) * N * ((N + c.tz - 1) / c.tz) + wg - 1) / wg * wg;  // two per piece
     std::vector<cl_event>* events = nullptr;  // when set, each stage's event is kept (profiling)
     auto stage = [&](cl_mem s, cl_mem b, cl_mem o, int second) {
       cl_kernel k = second ? k2 : k1;
