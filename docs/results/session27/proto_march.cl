@@ -4,6 +4,9 @@
 // cells read per element and stage); ORDER 4 marches a work-item up a column of TZ cells along z
 // (below), reading each of the 9 neighbouring columns' TZ + 2 cells once: 9 (TZ + 2) / TZ cells
 // per element instead of 27, each held in registers for the three connections it serves.
+// ORDER 5: the march without branches; 6: with computed indices (no grid reads, dense cube only);
+// 7: two work-items per column piece. LEAN=1: the connection with fewer instructions (all
+// orders). docs/PERF_NOTES.md "Session 27" has the results.
 #ifndef ORDER
 #define ORDER 0
 #endif
