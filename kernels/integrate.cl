@@ -277,9 +277,10 @@ kernel VB_STEP_ATTR void heun_predict(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PA
 // VB_CORRECT_REVERSE (Simulator::correct_reverse_, engine/sim/correct_order.hpp): heun_correct
 // takes the elements' aligned blocks of VB_REVERSE_BLOCK (the short loop's lockstep, so a warp
 // still holds one block of marks) from the last to the first, each block in order. It then starts
-// on the lines heun_predict wrote last, presumably still in L2, and ends on the elements the next
-// heun_predict starts with (H200, linear cubes of 1.0M-1.5M elements: 4-5% more steps/s; docs/
-// PERF_NOTES.md change 29). Each element's arithmetic is its own, so the order changes no result.
+// on the lines heun_predict wrote last, still in L2, and ends on the elements the next
+// heun_predict starts with (H200, linear cubes of 1.0M-1.5M elements: 4-5% more steps/s, both
+// stages reading 17-45% less from DRAM; docs/PERF_NOTES.md change 29 and session 27). Each
+// element's arithmetic is its own, so the order changes no result.
 #ifndef VB_CORRECT_REVERSE
 #define VB_CORRECT_REVERSE 0
 #endif

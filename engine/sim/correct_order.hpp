@@ -4,8 +4,9 @@
 /// constraint. The predictor walks the elements first to last, so the corrector then starts on the
 /// predicted stage's most recently written lines and ends on the elements the next predictor reads
 /// first. Measured on the H200 (docs/PERF_NOTES.md change 29), linear cubes: +4–5% at 1.0M and
-/// 1.5M, +2.5% at 4.1M, level at 512k (whose step's arrays presumably fit the 50 MB L2 either way)
-/// and 3% slower at 262k; two-term Ogden +0.5%, and with the volume constraint level.
+/// 1.5M, +2.5% at 4.1M, level at 512k (its DRAM reads fall by ~45%, but DRAM does not bound that
+/// step: Nsight Compute, PERF_NOTES.md session 27) and 3% slower at 262k (not known why);
+/// two-term Ogden +0.5%, and with the volume constraint level.
 #include <cstddef>
 
 namespace vb {

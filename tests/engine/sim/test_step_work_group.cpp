@@ -33,25 +33,20 @@ std::vector<double> run(const Scene& s, const char* wg, bool listed) {
   return test::state_uv(sim);
 }
 
-std::size_t differing(const std::vector<double>& a, const std::vector<double>& b) {
-  EXPECT_EQ(a.size(), b.size());
-  return test::differing_values(a, b);
-}
-
 TEST(StepWorkGroup, GroupSizeChangesNoBit) {
   for (const Integrator integrator : {Integrator::Heun, Integrator::SymplecticEuler, Integrator::Relaxation})
     for (const bool volume : {false, true})
       for (const bool listed : {false, true}) {
         const Scene s = test::mixed_block(integrator, volume);
         const std::vector<double> small = run(s, "32", listed), large = run(s, "256", listed);
-        EXPECT_EQ(differing(small, large), 0u)
+        EXPECT_EQ(test::differing_values(small, large), 0u)
             << "integrator " << int(integrator) << (volume ? ", volume" : "") << (listed ? ", list" : "");
       }
 }
 
 TEST(StepWorkGroup, GroupSizeChangesNoBitHyperelastic) {
   const Scene s = test::neo_hookean_mixed_block();
-  EXPECT_EQ(differing(run(s, "32", false), run(s, "256", false)), 0u);
+  EXPECT_EQ(test::differing_values(run(s, "32", false), run(s, "256", false)), 0u);
 }
 
 // 256 from 131,072 elements (H200: 2–12% from 262k up, level below; PERF_NOTES.md change 28).
