@@ -1,6 +1,8 @@
 // Session 28 prototype (docs/PERF_NOTES.md, attempt 37; not part of the build), session 27's
-// proto_march.cl with ORDER 8 added (the march in column order, at the end)
-// and MIN, the connection in fewer instructions (ORDERs 0 and 8). From session 26's
+// proto_march.cl with ORDER 8 added (the march in column order, at the end) and MIN, the
+// connection in fewer instructions (ORDERs 0 and 8); run by session 27's proto_march.cpp
+// (docs/results/session27/, unchanged: g++ -O2 -std=c++20 proto_march.cpp -o proto_march
+// -lOpenCL). From session 26's
 // proto_tile.cl: the same stage pair (main's short connection loop, layout 5: the state as u, v
 // float4, the predicted stage packed). ORDER 0 is main's gather (a work-item per element, 27
 // cells read per element and stage); ORDER 4 marches a work-item up a column of TZ cells along z
