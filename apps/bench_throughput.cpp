@@ -10,6 +10,8 @@
 
 #include "engine/bench/bench_knobs.hpp"
 #include "engine/bench/bench_scenes.hpp"
+#include "engine/bench/gather_floor.hpp"
+#include "engine/bench/paced_timing.hpp"
 #include "engine/lattice/lattice.hpp"
 #include "engine/lattice/voxelise.hpp"
 #include "engine/sim/simulator.hpp"
@@ -75,36 +77,22 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Enqueues `steps` steps in chunks of 32; after each chunk it waits for the one two chunks back,
-/// so that the queue never holds more than three chunks. A run issues at most check_every
-/// steps before it reads back; thousands of steps at once fill NVIDIA's queue, and the host
-/// blocked inside the driver then leaves gaps between launches (~20 µs per step at 1.5M elements:
-/// PERF_NOTES.md, session 17) that no run has.
-void advance_paced(Simulator& sim, std::int64_t steps) {
-  constexpr std::int64_t chunk = 32;
-  cl::Event before_last, last;
-  for (std::int64_t done = 0; done < steps; done += chunk) {
-    sim.advance(std::min(chunk, steps - done));
-    if (before_last()) before_last.wait();
-    before_last = last;
-    sim.context().queue.enqueueMarkerWithWaitList(nullptr, &last);
-    sim.context().queue.flush();
-  }
-}
-
 /// Steps per second, timed over enough steps to last about `target_s`.
 double time_steps(Simulator& sim, double target_s) {
   sim.advance(3);
   sim.check();  // warm-up, includes any lazy compilation
-  std::int64_t steps = 4;
-  for (;;) {
-    const auto t0 = std::chrono::steady_clock::now();
-    advance_paced(sim, steps);
-    sim.context().queue.finish();
-    const double t = seconds_since(t0);
-    if (t >= target_s || steps >= (1 << 22)) return double(steps) / t;
-    steps = std::int64_t(std::ceil(double(steps) * std::min(8.0, 1.2 * target_s / std::max(t, 1e-6))));
-  }
+  return bench::paced_steps_per_s(sim.context().queue, [&](std::int64_t steps) { sim.advance(steps); }, target_s);
+}
+
+/// The gather floor's rate for a model whose step is the one the floor mirrors: Heun in float on
+/// the GPUs' plain path (the predicted stage packed: linear springs, one work-item per element, no
+/// list, constraint or contact). None for any other step.
+std::optional<double> gather_floor_rate(const ClContext& cl, const Simulator& sim, const Lattice& lattice,
+                                        const ElementArrays& el, double target_s) {
+  if (!sim.pred_packed() || sim.precision() != Precision::Float) return std::nullopt;
+  bench::GatherFloor floor(cl, lattice, el.inverse_mass, sim.step_work_group(), sim.correct_reverse(),
+                           std::max<std::size_t>(1, cl.info.simd_width));
+  return floor.steps_per_s(target_s);
 }
 
 /// Host time to enqueue one step (s), from a batch short enough not to fill the queue (a full queue
@@ -316,7 +304,8 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
   nlohmann::json rows = nlohmann::json::array();
   std::ostringstream csv;
   csv << "model,elements,law,integrator,precision,steps_per_s,ns_per_element_step,bytes_per_element_step,"
-         "effective_bandwidth_gb_s,fraction_of_copy_bandwidth,device_bytes_per_element,free_elements\n";
+         "effective_bandwidth_gb_s,fraction_of_copy_bandwidth,device_bytes_per_element,free_elements,"
+         "gather_floor_steps_per_s,fraction_of_gather_floor\n";
   for (const BenchCase& c : cases) {
     Scene scene;
     Lattice lattice;
@@ -349,6 +338,10 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     std::printf("%-12s %9zu elements (%zu free)  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
                 c.name.c_str(), n, n_free, c.law.c_str(), c.integrator.c_str(), prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
     std::fflush(stdout);
+    const std::optional<double> floor_sps = gather_floor_rate(cl, sim, lattice, el, target_s);
+    if (floor_sps)
+      std::printf("    gather floor %.1f steps/s (the step's reads and writes alone): the step at %.1f%% of it\n", *floor_sps,
+                  100 * sps / *floor_sps);
     nlohmann::json row = {{"model", c.name}, {"elements", n}, {"free_elements", n_free}, {"law", c.law}, {"integrator", c.integrator}, {"precision", prec},
                           {"steps_per_s", sps}, {"bytes_per_element_step", bytes}, {"effective_bandwidth_gb_s", effective / 1e9},
                           {"fraction_of_copy_bandwidth", effective / bandwidth},
@@ -369,10 +362,17 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                           // Heun's corrector over the blocks last to first (change 29)
                           {"correct_reverse", sim.correct_reverse()},
                           // the stepping kernels' work-group size, 0: the device's choice (change 28)
-                          {"step_work_group", sim.step_work_group()}};
+                          {"step_work_group", sim.step_work_group()},
+                          // the same kernels without their arithmetic (engine/bench/gather_floor.hpp)
+                          {"gather_floor_steps_per_s", floor_sps ? nlohmann::json(*floor_sps) : nlohmann::json()},
+                          {"fraction_of_gather_floor", floor_sps ? nlohmann::json(sps / *floor_sps) : nlohmann::json()}};
     csv << c.name << "," << n << "," << c.law << "," << c.integrator << "," << prec << "," << sps << "," << 1e9 / (sps * double(n)) << ","
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
-        << "," << n_free << "\n";
+        << "," << n_free << ",";
+    if (floor_sps)
+      csv << *floor_sps << "," << sps / *floor_sps << "\n";
+    else
+      csv << ",\n";
     if (o.profile) {
       // Which side sets the pace: the host's launches (enqueue time close to the step) or the
       // device (its time alone close to the step).

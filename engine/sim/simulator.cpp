@@ -10,6 +10,7 @@
 #include "engine/error.hpp"
 #include "engine/sim/correct_order.hpp"
 #include "engine/sim/kernel_tables.hpp"
+#include "engine/sim/padded_grid.hpp"
 #include "engine/sim/step_list_rule.hpp"
 #include "engine/sim/step_work_group.hpp"
 #include "engine/sim/triangle_contact.hpp"
@@ -164,10 +165,10 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   require(dt_.dt_s > 0 && std::isfinite(dt_.dt_s), "time step must be positive and finite", "solver.dt");
 
   // Padded voxel grid: one empty layer on every side, so neighbour lookups never leave it.
-  const std::array<int, 3> pad = {lattice.dims[0] + 2, lattice.dims[1] + 2, lattice.dims[2] + 2};
-  stride_y_ = pad[0];
-  stride_z_ = pad[0] * pad[1];
-  const std::size_t cells = std::size_t(pad[0]) * pad[1] * pad[2];
+  const PaddedGrid shape = padded_grid_shape(lattice);
+  stride_y_ = shape.stride_y;
+  stride_z_ = shape.stride_z;
+  const std::size_t cells = shape.cells;
   require(cells < 0x7fffffffu, "the model's bounding box has too many voxels for 32-bit indexing", "model",
           "downsample or crop the model");
 
@@ -217,13 +218,9 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
           "model", "set model.downsample to at least " + std::to_string(fitting_downsample(device_bytes_, cl.info)) +
                        ", crop the model (model.roi_min/max, model.keep), or use float precision");
 
-  std::vector<cl_int> grid(cells, -1);
-  std::vector<cl_uint> cell_of(n_);
-  for (std::size_t e = 0; e < n_; ++e) {
-    const auto ijk = lattice.voxel_ijk(e);
-    cell_of[e] = cl_uint((ijk[0] + 1) + stride_y_ * (ijk[1] + 1) + std::size_t(stride_z_) * (ijk[2] + 1));
-    grid[cell_of[e]] = cl_int(e);
-  }
+  const PaddedGrid padded = make_padded_grid(lattice);
+  const std::vector<cl_int>& grid = padded.element_of_cell;
+  const std::vector<cl_uint>& cell_of = padded.cell_of_element;
 
   // The unloaded reference state: rest offsets (zero until set_rest_offsets), and for
   // hyperelastic tissue the rest frame R₀, J₀ (kernels/hyperelastic.cl); placeholders otherwise.
