@@ -51,6 +51,24 @@ if "Portable Computing Language" in bench["platform"]:
     print("lanes kernels on PoCL:", sorted({r["model"] for r in rows}))
 PY
 
+# The gather floor (engine/bench/gather_floor.hpp) is measured beside every row whose step it
+# mirrors: Heun in float on the GPUs' plain path (the short loop, the predicted stage packed).
+# PoCL's rows step with the lanes kernels and leave its columns empty; forced onto the GPUs' path
+# here, the row must carry a finite positive floor and the step's fraction of it.
+"$bin" bench --quick --no-study --sizes 10 --laws linear --out "$work/floor_lanes" >/dev/null
+VOXBREAST_LANES=0 VOXBREAST_UNIFORM_PATH=1 VOXBREAST_PRED_PACKED=1 \
+  "$bin" bench --quick --no-study --sizes 10 --laws linear --out "$work/floor" >/dev/null
+/usr/bin/python3 - "$work/floor_lanes/throughput.csv" "$work/floor/throughput.csv" <<'PY'
+import csv, math, sys
+lanes, = list(csv.DictReader(open(sys.argv[1])))
+row, = list(csv.DictReader(open(sys.argv[2])))
+assert lanes["gather_floor_steps_per_s"] == "" and lanes["fraction_of_gather_floor"] == "", lanes
+floor, fraction = float(row["gather_floor_steps_per_s"]), float(row["fraction_of_gather_floor"])
+assert math.isfinite(floor) and floor > 0, row
+assert abs(fraction - float(row["steps_per_s"]) / floor) <= 1e-4 * fraction, row
+print("gather floor on the GPUs' path (PoCL): %.1f steps/s, the step at %.1f%%" % (floor, 100 * fraction))
+PY
+
 # --profile: which side sets the pace. The device's time alone (steps queued behind a held queue,
 # the holder's own time taken off, median of three runs) must be measured and be a real step
 # time. It is not compared with the timed step here: the two are taken at different moments on
