@@ -28,11 +28,16 @@ def main(csv_path, png_path, title):
         law = "" if r["law"] == "linear" else f'{r["law"]}, '
         key = f'{family}{law}{r["integrator"]}, {r["precision"]}'
         series.setdefault(key, []).append((int(r["elements"]), float(r["steps_per_s"]), float(r["ns_per_element_step"])))
+        # the gather floor measured beside the row (the same kernels without their arithmetic;
+        # engine/bench/gather_floor.hpp), where the row's step is the one it mirrors
+        if r.get("gather_floor_steps_per_s"):
+            floor = float(r["gather_floor_steps_per_s"])
+            series.setdefault(f"gather floor of {key}", []).append((int(r["elements"]), floor, 1e9 / (floor * int(r["elements"]))))
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
     for key, pts in sorted(series.items()):
         pts.sort()
         n = [p[0] for p in pts]
-        style = "s--" if key.startswith("phantom") else "o-"
+        style = "s--" if key.startswith("phantom") else "k^:" if key.startswith("gather floor") else "o-"
         a.loglog(n, [p[1] for p in pts], style, label=key)
         b.semilogx(n, [p[2] for p in pts], style, label=key)
     a.set_xlabel("elements")
