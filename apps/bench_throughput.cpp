@@ -86,10 +86,17 @@ double time_steps(Simulator& sim, double target_s) {
 
 /// The gather floor's rate for a model whose step is the one the floor mirrors: Heun in float on
 /// the GPUs' plain path (the predicted stage packed: linear springs, one work-item per element, no
-/// list, constraint or contact). None for any other step.
+/// list, constraint or contact). None for any other step, and where the floor's own arrays would
+/// not fit on the device beside the model's (said on the terminal).
 std::optional<double> gather_floor_rate(const ClContext& cl, const Simulator& sim, const Lattice& lattice,
                                         const ElementArrays& el, double target_s) {
   if (!sim.pred_packed() || sim.precision() != Precision::Float) return std::nullopt;
+  const double needed = double(sim.device_bytes() + bench::GatherFloor::device_bytes(lattice));
+  if (needed > 0.9 * double(cl.info.global_memory_bytes)) {
+    std::printf("    gather floor not measured: with the model it needs %.0f MiB of the device's %.0f MiB\n",
+                needed / 1048576.0, double(cl.info.global_memory_bytes) / 1048576.0);
+    return std::nullopt;
+  }
   bench::GatherFloor floor(cl, lattice, el.inverse_mass, sim.step_work_group(), sim.correct_reverse(),
                            std::max<std::size_t>(1, cl.info.simd_width));
   return floor.steps_per_s(target_s);

@@ -60,6 +60,11 @@ GatherFloor::GatherFloor(const ClContext& cl, const Lattice& lattice, const std:
   if (work_group) local_ = cl::NDRange(work_group);
 }
 
+std::size_t GatherFloor::device_bytes(const Lattice& lattice) {
+  // u, v: 4 words; the packed stage: 6; cell and E: 1 each; the padded grid: 1 per cell
+  return lattice.element_count() * 12 * sizeof(cl_float) + padded_grid_shape(lattice).cells * sizeof(cl_int);
+}
+
 void GatherFloor::enqueue_predict() { cl_.queue.enqueueNDRangeKernel(predict_, cl::NullRange, global_, local_); }
 
 void GatherFloor::enqueue_correct() { cl_.queue.enqueueNDRangeKernel(correct_, cl::NullRange, global_, local_); }

@@ -21,6 +21,9 @@ class GatherFloor {
   GatherFloor(const ClContext& cl, const Lattice& lattice, const std::vector<double>& inverse_mass,
               std::size_t work_group, bool reverse, std::size_t block);
 
+  /// Device memory the floor allocates for `lattice` (its own state, stage, grid and E).
+  static std::size_t device_bytes(const Lattice& lattice);
+
   void enqueue_predict();
   void enqueue_correct();
   void enqueue_steps(std::int64_t steps);
