@@ -38,22 +38,17 @@ GatherFloor::GatherFloor(const ClContext& cl, const Lattice& lattice, const std:
   cl::Program p = build_program(cl, {"common.cl", "gather_floor.cl"}, lattice_tables_source(), "-DVB_DOUBLE=0");
   predict_ = cl::Kernel(p, "gather_floor_predict");
   correct_ = cl::Kernel(p, "gather_floor_correct");
-  int a = 0;
-  for (const cl::Buffer* b : {&u_, &v_, &grid_, &cell_of_, &E_}) predict_.setArg(a++, *b);
-  predict_.setArg(a++, cl_int(grid.stride_y));
-  predict_.setArg(a++, cl_int(grid.stride_z));
-  predict_.setArg(a++, u_pred_);
-  predict_.setArg(a++, v_pred_);
-  predict_.setArg(a++, cl_uint(n_));
-  a = 0;
-  for (const cl::Buffer* b : {&u_, &v_, &grid_, &cell_of_, &E_}) correct_.setArg(a++, *b);
-  correct_.setArg(a++, cl_int(grid.stride_y));
-  correct_.setArg(a++, cl_int(grid.stride_z));
-  correct_.setArg(a++, u_pred_);
-  correct_.setArg(a++, v_pred_);
-  correct_.setArg(a++, cl_uint(n_));
-  correct_.setArg(a++, cl_int(reverse));
-  correct_.setArg(a++, cl_uint(std::max<std::size_t>(1, block)));
+  // both kernels: u, v, grid, cell_of, E, sy, sz, u_pred, v_pred, n; the corrector's order after them
+  for (cl::Kernel* k : {&predict_, &correct_}) {
+    int a = 0;
+    for (const cl::Buffer* b : {&u_, &v_, &grid_, &cell_of_, &E_}) k->setArg(a++, *b);
+    k->setArg(a++, cl_int(grid.stride_y));
+    k->setArg(a++, cl_int(grid.stride_z));
+    for (const cl::Buffer* b : {&u_pred_, &v_pred_}) k->setArg(a++, *b);
+    k->setArg(a++, cl_uint(n_));
+  }
+  correct_.setArg(10, cl_int(reverse));
+  correct_.setArg(11, cl_uint(std::max<std::size_t>(1, block)));
   // as the step: whole groups (the reversed corrector's blocks too), the device's choice when 0
   const std::size_t round = std::max<std::size_t>({1, work_group, block});
   global_ = cl::NDRange((n_ + round - 1) / round * round);
