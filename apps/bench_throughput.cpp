@@ -88,8 +88,8 @@ double time_steps(Simulator& sim, double target_s) {
 /// the GPUs' plain path (the predicted stage packed: linear springs, one work-item per element, no
 /// list, constraint or contact). None for any other step, and where the floor's own arrays would
 /// not fit on the device beside the model's (said on the terminal).
-std::optional<double> gather_floor_rate(const ClContext& cl, const Simulator& sim, const Lattice& lattice,
-                                        const ElementArrays& el, double target_s) {
+std::optional<double> gather_floor_rate(const ClContext& cl, const Simulator& sim, const Scene& scene,
+                                        const Lattice& lattice, const ElementArrays& el, double target_s) {
   if (!sim.pred_packed() || sim.precision() != Precision::Float) return std::nullopt;
   const double needed = double(sim.device_bytes() + bench::GatherFloor::device_bytes(lattice));
   if (needed > 0.9 * double(cl.info.global_memory_bytes)) {
@@ -98,7 +98,7 @@ std::optional<double> gather_floor_rate(const ClContext& cl, const Simulator& si
     return std::nullopt;
   }
   bench::GatherFloor floor(cl, lattice, el.inverse_mass, sim.step_work_group(), sim.correct_reverse(),
-                           std::max<std::size_t>(1, cl.info.simd_width));
+                           std::max<std::size_t>(1, cl.info.simd_width), scene.solver.dashpot_ratio > 0);
   return floor.steps_per_s(target_s);
 }
 
@@ -345,7 +345,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     std::printf("%-12s %9zu elements (%zu free)  %-11s %-16s %-6s %10.1f steps/s  %6.2f ns/element-step  %5.1f%% of copy bandwidth\n",
                 c.name.c_str(), n, n_free, c.law.c_str(), c.integrator.c_str(), prec, sps, 1e9 / (sps * double(n)), 100 * effective / bandwidth);
     std::fflush(stdout);
-    const std::optional<double> floor_sps = gather_floor_rate(cl, sim, lattice, el, target_s);
+    const std::optional<double> floor_sps = gather_floor_rate(cl, sim, scene, lattice, el, target_s);
     if (floor_sps)
       std::printf("    gather floor %.1f steps/s (the step's reads and writes alone): the step at %.1f%% of it\n", *floor_sps,
                   100 * sps / *floor_sps);

@@ -5,8 +5,12 @@
 // E, cell, its 26 grid entries and the 26 neighbours' state, in the same layout and order) and
 // writes what that stage writes; the neighbours' words are only combined by XOR (2-3 instructions
 // a neighbour), so that the compiler keeps every load. The results are meaningless as physics;
-// the stage is written into the floor's own buffers. Built with -DVB_DOUBLE=0 (float words).
-// docs/PERF_NOTES.md, session 31.
+// the stage is written into the floor's own buffers. Built with -DVB_DOUBLE=0 (float words) and
+// -DVB_FLOOR_DASHPOT=0|1 as the step's VB_DASHPOT: only the connection dashpots read the
+// neighbours' velocities. docs/PERF_NOTES.md, session 31.
+#ifndef VB_FLOOR_DASHPOT
+#define VB_FLOOR_DASHPOT 1
+#endif
 
 #define VB_BITS(x) as_uint(x)
 
@@ -17,7 +21,8 @@ inline uint floor_neighbour(global const int* grid, int cell, int sy, int sz, ui
   return jn >= 0 ? (uint)jn : e;
 }
 
-// The predictor's reads: u, v as real4 (x, y, z of each), own u, v, E, cell; writes the packed
+// The predictor's reads: u, v as real4 (x, y, z of each; v only with dashpots), own u, v, E, cell;
+// writes the packed
 // stage (u: ũx, ũy, ũz, ṽx; v2: ṽy, ṽz). Held elements (u.w = 0) only copy, as in the step.
 kernel void gather_floor_predict(global const real4* u, global const real4* v, global const int* grid,
                                  global const uint* cell_of, global const real* E, int sy, int sz,
@@ -31,8 +36,12 @@ kernel void gather_floor_predict(global const real4* u, global const real4* v, g
 #pragma unroll
     for (int d = 0; d < 26; ++d) {
       const uint j = floor_neighbour(grid, cell, sy, sz, e, d);
-      const real4 uj = u[j], vj = v[j];
-      acc ^= VB_BITS(uj.x) ^ VB_BITS(uj.y) ^ VB_BITS(uj.z) ^ VB_BITS(vj.x) ^ VB_BITS(vj.y) ^ VB_BITS(vj.z);
+      const real4 uj = u[j];
+      acc ^= VB_BITS(uj.x) ^ VB_BITS(uj.y) ^ VB_BITS(uj.z);
+#if VB_FLOOR_DASHPOT
+      const real4 vj = v[j];
+      acc ^= VB_BITS(vj.x) ^ VB_BITS(vj.y) ^ VB_BITS(vj.z);
+#endif
     }
     vi.x = as_float(VB_BITS(vi.x) ^ acc);
   }
@@ -40,7 +49,8 @@ kernel void gather_floor_predict(global const real4* u, global const real4* v, g
   v_pred[e] = (real2)(vi.y, vi.z);
 }
 
-// The corrector's reads: the packed stage of the element and its neighbours (real4 + real2), the
+// The corrector's reads: the packed stage of the element and its neighbours (real4 + real2; ũ alone
+// without dashpots), the
 // element's inverse mass from u.w, E, cell, then its own u, v; writes u, v. Over the elements'
 // blocks of `block` last to first when `reverse` (VB_CORRECT_REVERSE), in order otherwise.
 kernel void gather_floor_correct(global real4* u, global real4* v, global const int* grid, global const uint* cell_of,
@@ -58,9 +68,12 @@ kernel void gather_floor_correct(global real4* u, global real4* v, global const 
 #pragma unroll
   for (int d = 0; d < 26; ++d) {
     const uint j = floor_neighbour(grid, cell, sy, sz, e, d);
-    const real4 uj = u_pred[j];
-    const real2 vj = v_pred[j];
-    acc ^= VB_BITS(uj.x) ^ VB_BITS(uj.y) ^ VB_BITS(uj.z) ^ VB_BITS(uj.w) ^ VB_BITS(vj.x) ^ VB_BITS(vj.y);
+    const real4 uj = u_pred[j];  // ũx, ũy, ũz, ṽx
+    acc ^= VB_BITS(uj.x) ^ VB_BITS(uj.y) ^ VB_BITS(uj.z);
+#if VB_FLOOR_DASHPOT
+    const real2 vj = v_pred[j];  // ṽy, ṽz
+    acc ^= VB_BITS(uj.w) ^ VB_BITS(vj.x) ^ VB_BITS(vj.y);
+#endif
   }
   real4 ui = u[e], vi = v[e];
   ui.x = as_float(VB_BITS(ui.x) ^ acc);

@@ -1,5 +1,7 @@
 #include "engine/bench/gather_floor.hpp"
 
+#include <string>
+
 #include "engine/bench/paced_timing.hpp"
 #include "engine/sim/kernel_tables.hpp"
 #include "engine/sim/padded_grid.hpp"
@@ -16,7 +18,7 @@ cl::Buffer upload(const ClContext& cl, const std::vector<T>& data) {
 }  // namespace
 
 GatherFloor::GatherFloor(const ClContext& cl, const Lattice& lattice, const std::vector<double>& inverse_mass,
-                         std::size_t work_group, bool reverse, std::size_t block)
+                         std::size_t work_group, bool reverse, std::size_t block, bool dashpots)
     : cl_(cl), n_(lattice.element_count()) {
   const PaddedGrid grid = make_padded_grid(lattice);
   // Distinct words per element (the tests follow each neighbour's); u.w the inverse mass, as in
@@ -35,7 +37,8 @@ GatherFloor::GatherFloor(const ClContext& cl, const Lattice& lattice, const std:
   grid_ = upload(cl, grid.element_of_cell);
   cell_of_ = upload(cl, grid.cell_of_element);
   E_ = upload(cl, E);
-  cl::Program p = build_program(cl, {"common.cl", "gather_floor.cl"}, lattice_tables_source(), "-DVB_DOUBLE=0");
+  cl::Program p = build_program(cl, {"common.cl", "gather_floor.cl"}, lattice_tables_source(),
+                                  "-DVB_DOUBLE=0 -DVB_FLOOR_DASHPOT=" + std::to_string(int(dashpots)));
   predict_ = cl::Kernel(p, "gather_floor_predict");
   correct_ = cl::Kernel(p, "gather_floor_correct");
   // both kernels: u, v, grid, cell_of, E, sy, sz, u_pred, v_pred, n; the corrector's order after them

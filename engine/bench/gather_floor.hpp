@@ -17,9 +17,10 @@ class GatherFloor {
  public:
   /// `inverse_mass`: per element, 0 for held ones (the step does not step them). `work_group`: the
   /// step's (0: the device's choice). `reverse`: the corrector over blocks of `block` elements
-  /// from the last to the first (Simulator::correct_reverse).
+  /// from the last to the first (Simulator::correct_reverse). `dashpots`: the step has connection
+  /// dashpots (solver.dashpot_ratio > 0), so it reads the neighbours' velocities too.
   GatherFloor(const ClContext& cl, const Lattice& lattice, const std::vector<double>& inverse_mass,
-              std::size_t work_group, bool reverse, std::size_t block);
+              std::size_t work_group, bool reverse, std::size_t block, bool dashpots);
 
   /// Device memory the floor allocates for `lattice` (its own state, stage, grid and E).
   static std::size_t device_bytes(const Lattice& lattice);
