@@ -33,8 +33,9 @@ struct BenchCase {
 /// its own 4 mm): the size of the main paper's hyperelastic breast model and of issue 7's target.
 constexpr double kBreastSpacing = 0.0032;
 
-/// A cube of `edge`³ adipose elements, base held, under gravity: the standard linear block.
-Scene block_scene(const BenchCase& c) {
+/// A cube of `edge`³ adipose elements, base held, under gravity: the standard linear block, its
+/// connection dashpots of ratio `dashpot_ratio` (the solver's default 0.1 unless asked).
+Scene block_scene(const BenchCase& c, double dashpot_ratio) {
   Scene s;
   const double h = 0.002;
   ShapeSpec box;
@@ -61,6 +62,7 @@ Scene block_scene(const BenchCase& c) {
   bench::apply_integrator(s, c.integrator);
   s.solver.precision = c.precision;
   s.solver.damping_per_s = 5;
+  s.solver.dashpot_ratio = dashpot_ratio;
   s.gravity.active = true;
   s.gravity.acceleration_m_s2 = Vec3(0, 0, -9.80665);
   AnchorSpec base;
@@ -312,7 +314,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
   std::ostringstream csv;
   csv << "model,elements,law,integrator,precision,steps_per_s,ns_per_element_step,bytes_per_element_step,"
          "effective_bandwidth_gb_s,fraction_of_copy_bandwidth,device_bytes_per_element,free_elements,"
-         "gather_floor_steps_per_s,fraction_of_gather_floor\n";
+         "gather_floor_steps_per_s,fraction_of_gather_floor,dashpot_ratio\n";
   for (const BenchCase& c : cases) {
     Scene scene;
     Lattice lattice;
@@ -324,7 +326,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
       scene.volume.preserve = c.volume;
       lattice = build_lattice(c.phantom->volume);
     } else {
-      scene = block_scene(c);
+      scene = block_scene(c, o.cube_dashpot_ratio);
       lattice = build_lattice(voxelise_shapes(scene));
     }
     scene.volume.predictor = o.volume_predictor;
@@ -370,6 +372,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                           {"correct_reverse", sim.correct_reverse()},
                           // the stepping kernels' work-group size, 0: the device's choice (change 28)
                           {"step_work_group", sim.step_work_group()},
+                          {"dashpot_ratio", scene.solver.dashpot_ratio},
                           // the same kernels without their arithmetic (engine/bench/gather_floor.hpp)
                           {"gather_floor_steps_per_s", floor_sps ? nlohmann::json(*floor_sps) : nlohmann::json()},
                           {"fraction_of_gather_floor", floor_sps ? nlohmann::json(sps / *floor_sps) : nlohmann::json()}};
@@ -377,9 +380,10 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
         << bytes << "," << effective / 1e9 << "," << effective / bandwidth << "," << double(sim.device_bytes()) / double(n)
         << "," << n_free << ",";
     if (floor_sps)
-      csv << *floor_sps << "," << sps / *floor_sps << "\n";
+      csv << *floor_sps << "," << sps / *floor_sps;
     else
-      csv << ",\n";
+      csv << ",";
+    csv << "," << scene.solver.dashpot_ratio << "\n";
     if (o.profile) {
       // Which side sets the pace: the host's launches (enqueue time close to the step) or the
       // device (its time alone close to the step).

@@ -17,6 +17,7 @@ struct ThroughputOptions {
   bool volume = false;   ///< also time each law with [volume] preserve = true (model "block_volume")
   VolumeSpec::Predictor volume_predictor = VolumeSpec::Predictor::Pressure;  ///< [volume] predictor of those
   bool profile = false;  ///< print device time per kernel (a second, profiling run of each block)
+  double cube_dashpot_ratio = SolverSpec{}.dashpot_ratio;  ///< the cubes' dashpots ζ (0: global damping only)
   std::string phantom_scene;  ///< the breast phantom's scene.toml, for the two options below
   /// also time the phantom resampled to ~36k elements (models "breast", "breast_volume"), every law
   bool breast = false;

@@ -40,6 +40,7 @@ struct BenchOptions {
   bool breast_large = false;  ///< throughput: the phantom at ~1.5M elements too
   std::vector<long> breast_elements;  ///< throughput: the phantom resampled to about these counts
   std::vector<int> sizes;  ///< throughput blocks (edge lengths in elements)
+  double cube_dashpot_ratio = SolverSpec{}.dashpot_ratio;  ///< throughput: the cubes' connection dashpots ζ
   std::vector<int> haptic_elements = {10000};  ///< haptic-rate blocks (about this many elements)
   double haptic_seconds = 3;
   std::vector<std::string> laws, integrators, scenes;
@@ -153,6 +154,7 @@ int run_bench(BenchOptions o) {
     t.volume_predictor =
         o.volume_predictor == "projection" ? VolumeSpec::Predictor::Projection : VolumeSpec::Predictor::Pressure;
     t.profile = o.profile;
+    t.cube_dashpot_ratio = o.cube_dashpot_ratio;
     if (breast_any) {
       require(!o.phantom.empty(), "--breast, --breast-large and --breast-elements need the phantom's scene",
               "bench --breast", "give --phantom");
@@ -242,6 +244,10 @@ Command add_bench(CLI::App& app) {
                   "each of --laws (default linear) and --integrators (default heun) (model breast_resampled)")
       ->check(CLI::Range(1000L, 100000000L));
   sub->add_flag("--volume", o->volume, "throughput: also time each law with [volume] preserve = true (model block_volume)");
+  sub->add_option("--dashpot-ratio", o->cube_dashpot_ratio,
+                  "throughput: the cubes' connection dashpot ratio ζ (solver.dashpot_ratio; default 0.1; 0: global "
+                  "damping only), to time what the dashpots cost")
+      ->check(CLI::Range(0.0, 10.0));
   sub->add_option("--volume-predictor", o->volume_predictor,
                   "throughput: [volume] predictor of the --volume models: pressure (default) or projection, to time "
                   "the two ways Heun's predicted stage meets the constraint")

@@ -56,17 +56,24 @@ PY
 # PoCL's rows step with the lanes kernels and leave its columns empty; forced onto the GPUs' path
 # here, the row must carry a finite positive floor and the step's fraction of it.
 "$bin" bench --quick --no-study --sizes 10 --laws linear --out "$work/floor_lanes" >/dev/null
-VOXBREAST_LANES=0 VOXBREAST_UNIFORM_PATH=1 VOXBREAST_PRED_PACKED=1 \
-  "$bin" bench --quick --no-study --sizes 10 --laws linear --out "$work/floor" >/dev/null
-/usr/bin/python3 - "$work/floor_lanes/throughput.csv" "$work/floor/throughput.csv" <<'PY'
+# --dashpot-ratio 0 (global damping only) must reach the row and its floor (which then reads no
+# neighbour velocity).
+for zeta in 0.1 0; do
+  VOXBREAST_LANES=0 VOXBREAST_UNIFORM_PATH=1 VOXBREAST_PRED_PACKED=1 \
+    "$bin" bench --quick --no-study --sizes 10 --laws linear --dashpot-ratio $zeta --out "$work/floor_$zeta" >/dev/null
+done
+/usr/bin/python3 - "$work/floor_lanes/throughput.csv" "$work/floor_0.1/throughput.csv" "$work/floor_0/throughput.csv" <<'PY'
 import csv, math, sys
 lanes, = list(csv.DictReader(open(sys.argv[1])))
-row, = list(csv.DictReader(open(sys.argv[2])))
 assert lanes["gather_floor_steps_per_s"] == "" and lanes["fraction_of_gather_floor"] == "", lanes
-floor, fraction = float(row["gather_floor_steps_per_s"]), float(row["fraction_of_gather_floor"])
-assert math.isfinite(floor) and floor > 0, row
-assert abs(fraction - float(row["steps_per_s"]) / floor) <= 1e-4 * fraction, row
-print("gather floor on the GPUs' path (PoCL): %.1f steps/s, the step at %.1f%%" % (floor, 100 * fraction))
+assert float(lanes["dashpot_ratio"]) == 0.1, lanes
+for path, zeta in zip(sys.argv[2:], (0.1, 0.0)):
+    row, = list(csv.DictReader(open(path)))
+    assert float(row["dashpot_ratio"]) == zeta, row
+    floor, fraction = float(row["gather_floor_steps_per_s"]), float(row["fraction_of_gather_floor"])
+    assert math.isfinite(floor) and floor > 0, row
+    assert abs(fraction - float(row["steps_per_s"]) / floor) <= 1e-4 * fraction, row
+    print("gather floor on the GPUs' path (PoCL), dashpots %g: %.1f steps/s, the step at %.1f%%" % (zeta, floor, 100 * fraction))
 PY
 
 # --profile: which side sets the pace. The device's time alone (steps queued behind a held queue,
