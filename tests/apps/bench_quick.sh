@@ -56,6 +56,12 @@ PY
 # PoCL's rows step with the lanes kernels and leave its columns empty; forced onto the GPUs' path
 # here, the row must carry a finite positive floor and the step's fraction of it.
 "$bin" bench --quick --no-study --sizes 10 --laws linear --out "$work/floor_lanes" >/dev/null
+# An impossible dashpot ratio is refused by name, with a non-zero exit and nothing written.
+if "$bin" bench --quick --no-study --sizes 8 --dashpot-ratio -1 --out "$work/bad_zeta" >"$work/bad_zeta.txt" 2>&1; then
+  echo "bench accepted --dashpot-ratio -1"; exit 1
+fi
+grep -q -- "--dashpot-ratio" "$work/bad_zeta.txt" || { cat "$work/bad_zeta.txt"; exit 1; }
+[[ ! -e "$work/bad_zeta/bench.json" ]] || { echo "bench wrote output for a refused ratio"; exit 1; }
 # --dashpot-ratio 0 (global damping only) must reach the row and its floor (which then reads no
 # neighbour velocity).
 for zeta in 0.1 0; do
