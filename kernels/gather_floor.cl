@@ -22,8 +22,8 @@ inline uint floor_neighbour(global const int* grid, int cell, int sy, int sz, ui
 }
 
 // The predictor's reads: u, v as real4 (x, y, z of each; v only with dashpots), own u, v, E, cell;
-// writes the packed
-// stage (u: ũx, ũy, ũz, ṽx; v2: ṽy, ṽz). Held elements (u.w = 0) only copy, as in the step.
+// writes the packed stage (u: ũx, ũy, ũz, ṽx; v2: ṽy, ṽz). Held elements (u.w = 0) only copy, as
+// in the step.
 kernel void gather_floor_predict(global const real4* u, global const real4* v, global const int* grid,
                                  global const uint* cell_of, global const real* E, int sy, int sz,
                                  global real4* u_pred, global real2* v_pred, uint n) {
@@ -49,10 +49,10 @@ kernel void gather_floor_predict(global const real4* u, global const real4* v, g
   v_pred[e] = (real2)(vi.y, vi.z);
 }
 
-// The corrector's reads: the packed stage of the element and its neighbours (real4 + real2; ũ alone
-// without dashpots), the
-// element's inverse mass from u.w, E, cell, then its own u, v; writes u, v. Over the elements'
-// blocks of `block` last to first when `reverse` (VB_CORRECT_REVERSE), in order otherwise.
+// The corrector's reads: the packed stage of the element and its neighbours (real4 + real2; the
+// neighbours' ũ alone without dashpots), the element's inverse mass from u.w, E, cell, then its own
+// u, v; writes u, v. Over the elements' blocks of `block` last to first when `reverse`
+// (VB_CORRECT_REVERSE), in order otherwise.
 kernel void gather_floor_correct(global real4* u, global real4* v, global const int* grid, global const uint* cell_of,
                                  global const real* E, int sy, int sz, global const real4* u_pred,
                                  global const real2* v_pred, uint n, int reverse, uint block) {
