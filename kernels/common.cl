@@ -56,6 +56,14 @@ inline real dot3(real4 a, real4 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 // overflow, which NVIDIA compiles to three divisions and an IEEE square root per call.
 inline real norm3(real4 a) { return sqrt(dot3(a, a)); }
 
+// Heun's reversed corrector order (VB_CORRECT_REVERSE, kernels/integrate.cl; also the gather
+// floor's, kernels/gather_floor.cl): work-item i takes the elements' aligned blocks of `block` from
+// the last to the first, each block in order; UINT_MAX past the last block.
+inline uint reverse_block_element(uint i, uint n, uint block) {
+  const uint blocks = (n + block - 1) / block, b = i / block;
+  return b < blocks ? (blocks - 1 - b) * block + i % block : UINT_MAX;
+}
+
 // Rest (voxel-centre) position of the element stored at padded grid cell `cell`.
 // The padded grid has one empty voxel on every side: cell = (i+1) + sy·(j+1) + sz·(k+1).
 inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {

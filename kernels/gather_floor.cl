@@ -56,8 +56,7 @@ kernel void gather_floor_predict(global const real4* u, global const real4* v, g
 kernel void gather_floor_correct(global real4* u, global real4* v, global const int* grid, global const uint* cell_of,
                                  global const real* E, int sy, int sz, global const real4* u_pred,
                                  global const real2* v_pred, uint n, int reverse, uint block) {
-  const uint i = get_global_id(0), blocks = (n + block - 1) / block;
-  const uint e = !reverse ? i : i / block < blocks ? (blocks - 1 - i / block) * block + i % block : UINT_MAX;
+  const uint e = reverse ? reverse_block_element(get_global_id(0), n, block) : get_global_id(0);
   if (e >= n) return;
   const real4 up = u_pred[e];
   const real2 vp = v_pred[e];

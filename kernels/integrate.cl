@@ -288,11 +288,7 @@ kernel VB_STEP_ATTR void heun_predict(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PA
 #if VB_SPLIT > 1 || VB_STEP_LIST || VB_LANES || VB_PERSISTENT
 #error "VB_CORRECT_REVERSE: one work-item per element, in the elements' own order, only"
 #endif
-inline uint reverse_block_element(uint i, uint n) {
-  const uint blocks = (n + VB_REVERSE_BLOCK - 1) / VB_REVERSE_BLOCK, b = i / VB_REVERSE_BLOCK;
-  return b < blocks ? (blocks - 1 - b) * VB_REVERSE_BLOCK + i % VB_REVERSE_BLOCK : UINT_MAX;
-}
-#define VB_CORRECT_ELEMENT reverse_block_element(get_global_id(0), n)
+#define VB_CORRECT_ELEMENT reverse_block_element(get_global_id(0), n, VB_REVERSE_BLOCK)
 #else
 #define VB_CORRECT_ELEMENT VB_STEP_ELEMENT
 #endif

@@ -5,6 +5,7 @@
 #include "engine/bench/paced_timing.hpp"
 #include "engine/sim/kernel_tables.hpp"
 #include "engine/sim/padded_grid.hpp"
+#include "engine/sim/step_work_group.hpp"
 
 namespace vb::bench {
 namespace {
@@ -52,8 +53,8 @@ GatherFloor::GatherFloor(const ClContext& cl, const Lattice& lattice, const std:
   }
   correct_.setArg(10, cl_int(reverse));
   correct_.setArg(11, cl_uint(std::max<std::size_t>(1, block)));
-  // as the step: whole groups (the reversed corrector's blocks too), the device's choice when 0
-  const std::size_t round = std::max<std::size_t>({1, work_group, block});
+  // as the step (Simulator's step range): whole groups, of 128 where the device chooses their size
+  const std::size_t round = work_group ? work_group : kStepWorkGroup;
   global_ = cl::NDRange((n_ + round - 1) / round * round);
   if (work_group) local_ = cl::NDRange(work_group);
 }
