@@ -46,6 +46,7 @@ std::string phantom_scene(const Phantom& p, const PhantomSpec& spec) {
 
 int run_phantom(const PhantomOptions& o) {
   const OutputDir output_dir(o.out);
+  check_dicom_series_replaceable(o.out + "/dicom");  // refuse before any file is replaced
   PhantomSpec spec;
   spec.seed = o.seed;
   spec.spacing_m = o.spacing_mm * 1e-3;
@@ -53,7 +54,7 @@ int run_phantom(const PhantomOptions& o) {
   const Phantom p = make_breast_phantom(spec);
   write_nifti(o.out + "/ct.nii.gz", p.ct, NiftiType::Int16);
   write_nifti(o.out + "/labels.nii.gz", p.labels, NiftiType::UInt8);
-  write_dicom_series(o.out + "/dicom", p.ct, "VoxBreast synthetic breast phantom");
+  replace_dicom_series(o.out + "/dicom", p.ct, "VoxBreast synthetic breast phantom");
   write_text_atomically(o.out + "/scene.toml", phantom_scene(p, spec));
   std::printf("phantom %d × %d × %d voxels of %.1f mm, seed %llu\nwrote %s/ct.nii.gz, labels.nii.gz, dicom/, scene.toml\n",
               p.ct.dims[0], p.ct.dims[1], p.ct.dims[2], o.spacing_mm, (unsigned long long)o.seed, o.out.c_str());

@@ -1,7 +1,6 @@
 #include "apps/image_outputs.hpp"
 
 #include <cmath>
-#include <filesystem>
 
 #include "engine/image/deformation_field.hpp"
 #include "io/dicom_io.hpp"
@@ -41,8 +40,7 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
       written["warped_ct"] = "warped_ct.nii.gz";
     }
     if (want.warped_ct_dicom) {
-      std::filesystem::remove_all(dir + "/warped_ct_dicom");  // a previous run's series in this output folder
-      write_dicom_series(dir + "/warped_ct_dicom", warp.warped, "VoxBreast warped CT");
+      replace_dicom_series(dir + "/warped_ct_dicom", warp.warped, "VoxBreast warped CT");  // a rerun replaces its own earlier series
       written["warped_ct_dicom"] = "warped_ct_dicom/";
     }
     written["warp_vacated_voxels"] = warp.vacated_voxels;

@@ -10,6 +10,7 @@
 #include "apps/mesh_outputs.hpp"
 #include "io/atomic_file.hpp"
 #include "io/csv_table.hpp"
+#include "io/dicom_io.hpp"
 #include "io/hdf5_result.hpp"
 #include "io/json_summary.hpp"
 #include "io/metrics_csv.hpp"
@@ -48,6 +49,8 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
           "run voxbreast probe, or give the indenter a start");
   std::unique_lock io(file_io_mutex());
   const PreparedModel model = prepare_model(scene);
+  if (options.full_outputs && model.ct && scene.output.warped_ct_dicom)  // refuse before the run, not after it
+    check_dicom_series_replaceable(out_dir + "/warped_ct_dicom");
   io.unlock();
   check_positioning(scene, model.lattice);  // a misnamed tumour tissue fails now, not after the run
   Simulator sim(scene, model.lattice, model.elements, cl);

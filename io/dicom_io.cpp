@@ -1136,9 +1136,14 @@ class StagingFolder {
   bool committed_ = false;
 };
 
-fs::path clean_output_path(const std::string& dir) {
+fs::path normal_output_path(const std::string& dir) {
   fs::path path = fs::absolute(fs::path(dir)).lexically_normal();
   if (path.filename().empty()) path = path.parent_path();  // "out/" → "out"
+  return path;
+}
+
+fs::path clean_output_path(const std::string& dir) {
+  const fs::path path = normal_output_path(dir);
   std::error_code ec;
   const bool occupied =
       fs::exists(path, ec) && !(fs::is_directory(path, ec) && fs::is_empty(path, ec));
@@ -1146,6 +1151,25 @@ fs::path clean_output_path(const std::string& dir) {
           "choose a new folder; a DICOM series is never written over existing files");
   ensure_output_dir(path.parent_path().string());
   return path;
+}
+
+/// A folder this writer may replace whole: absent, or holding only regular files named as
+/// slice_file_name names them (an earlier series of this writer). Returns whether it exists.
+bool check_own_series_folder(const fs::path& path, const std::string& dir) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return false;
+  require(fs::is_directory(path, ec) && !fs::is_symlink(path, ec), "the output path exists and is not a folder",
+          dir, "remove it or choose another output folder");
+  for (const fs::directory_entry& entry : fs::directory_iterator(path, ec)) {
+    const std::string name = entry.path().filename().string();
+    const bool slice_name = name.size() == 11 && name.rfind("CT", 0) == 0 && name.substr(7) == ".dcm" &&
+                            std::all_of(name.begin() + 2, name.begin() + 7, [](char c) { return c >= '0' && c <= '9'; });
+    require(slice_name && entry.is_regular_file(ec) && !entry.is_symlink(ec),
+            "the output folder holds '" + name + "', which is not a slice of an earlier VoxBreast series", dir,
+            "a DICOM series replaces only its own earlier series: move it away or choose another output folder");
+  }
+  require(!ec, "cannot list the output folder: " + ec.message(), dir);
+  return true;
 }
 
 void check_writable(const ImageVolume& ct, const std::string& dir) {
@@ -1239,12 +1263,11 @@ ImageVolume read_dicom_series(const std::string& dir, const std::string& series_
   return read_dicom_series(dir, options, warnings);
 }
 
-void write_dicom_series(const std::string& dir, const ImageVolume& ct,
-                        const std::string& series_description) {
-  init_dcmtk();
-  check_writable(ct, dir);
-  const fs::path final_dir = clean_output_path(dir);
+namespace {
 
+/// The new series' attributes: geometry, rescale, carried patient and study, fresh UIDs.
+SeriesAttributes series_attributes(const ImageVolume& ct, const std::string& dir,
+                                   const std::string& series_description) {
   SeriesAttributes series;
   series.geometry = write_geometry(ct, dir);
   series.rescale = choose_rescale(ct.values, dir);
@@ -1254,11 +1277,58 @@ void write_dicom_series(const std::string& dir, const ImageVolume& ct,
   const auto source = ct.dicom_tags.find(kSourceSeriesKey);
   series.derivation = "VoxBreast " + std::string(config::version) + " output" +
                       (source != ct.dicom_tags.end() ? " from series " + source->second : "");
+  return series;
+}
 
-  StagingFolder staging(final_dir);
+void write_slices(const StagingFolder& staging, const ImageVolume& ct, const std::string& dir,
+                  const std::string& series_description) {
+  const SeriesAttributes series = series_attributes(ct, dir, series_description);
   for (int k = 0; k < ct.dims[2]; ++k)
     write_slice((staging.path() / slice_file_name(k)).string(), series, ct, k);
+}
+
+}  // namespace
+
+void write_dicom_series(const std::string& dir, const ImageVolume& ct,
+                        const std::string& series_description) {
+  init_dcmtk();
+  check_writable(ct, dir);
+  StagingFolder staging(clean_output_path(dir));
+  write_slices(staging, ct, dir, series_description);
   staging.commit();
+}
+
+void check_dicom_series_replaceable(const std::string& dir) { check_own_series_folder(normal_output_path(dir), dir); }
+
+void replace_dicom_series(const std::string& dir, const ImageVolume& ct,
+                          const std::string& series_description) {
+  init_dcmtk();
+  check_writable(ct, dir);
+  const fs::path final_dir = normal_output_path(dir);
+  const bool earlier = check_own_series_folder(final_dir, dir);
+  ensure_output_dir(final_dir.parent_path().string());
+  StagingFolder staging(final_dir);
+  write_slices(staging, ct, dir, series_description);
+  if (!earlier) {
+    staging.commit();
+    return;
+  }
+  // Swap by two renames, so the folder never holds slices of both series; the old one goes last.
+  const fs::path old_dir = final_dir.parent_path() / ("." + final_dir.filename().string() + ".old-" +
+                                                      std::to_string(::getpid()));
+  std::error_code ec;
+  fs::rename(final_dir, old_dir, ec);
+  require(!ec, "cannot move the earlier series aside: " + ec.message(), dir);
+  try {
+    staging.commit();
+  } catch (...) {
+    std::error_code ignored;
+    fs::rename(old_dir, final_dir, ignored);  // put the earlier series back
+    throw;
+  }
+  fs::remove_all(old_dir, ec);
+  require(!ec, "the new series is in place, but the earlier one could not be removed: " + ec.message(),
+          old_dir.string());
 }
 
 }  // namespace vb

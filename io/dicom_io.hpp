@@ -53,4 +53,16 @@ ImageVolume read_dicom_series(const std::string& dir, const std::string& series_
 void write_dicom_series(const std::string& dir, const ImageVolume& ct,
                         const std::string& series_description);
 
+/// As write_dicom_series, but `dir` may also hold an earlier series of this writer (only files
+/// named CT00001.dcm, CT00002.dcm, …), which the new series replaces whole: it is written beside
+/// it and swapped in by two renames, so `dir` never holds slices of both. A folder holding
+/// anything else is refused, unchanged. Run outputs (`warped_ct_dicom/`, the phantom's `dicom/`)
+/// use this, so a rerun into the same output folder replaces its own series.
+void replace_dicom_series(const std::string& dir, const ImageVolume& ct,
+                          const std::string& series_description);
+
+/// Throws the error replace_dicom_series would throw for `dir`'s contents, so a command can
+/// refuse before it computes anything.
+void check_dicom_series_replaceable(const std::string& dir);
+
 }  // namespace vb

@@ -63,6 +63,45 @@ PY
 then pass "NIfTI and DICOM inputs give the same result"
 else fail "NIfTI vs DICOM"; fi
 if dcmdump "$work/ct/warped_ct_dicom/CT00001.dcm" >/dev/null 2>&1; then pass "warped CT DICOM readable by dcmdump"; else fail "warped CT DICOM"; fi
+# A rerun into the same folder replaces its own warped series whole (a new series UID, no
+# leftovers); a file of someone else's in that folder stops the rerun before it computes.
+series_uid() { dcmdump +P 0020,000e "$1/warped_ct_dicom/CT00001.dcm" 2>/dev/null; }
+first_uid=$(series_uid "$work/ct"); slices=$(ls "$work/ct/warped_ct_dicom" | wc -l)
+if "$bin" simulate "$root/data-samples/phantom/scene_dicom.toml" --out "$work/ct" --quiet >/dev/null 2>&1 \
+   && [ -n "$first_uid" ] && [ "$(series_uid "$work/ct")" != "$first_uid" ] \
+   && [ "$(ls "$work/ct/warped_ct_dicom" | wc -l)" = "$slices" ] && [ -z "$(ls -A "$work/ct" | grep '^\.')" ]
+then pass "a rerun into the same folder replaces its warped CT series"
+else fail "rerun replaces the warped series"; fi
+h5_inode=$(stat -c %i "$work/ct/result.h5") && touch "$work/ct/warped_ct_dicom/notes.txt"  # a rewrite is a new inode
+if ! "$bin" simulate "$root/data-samples/phantom/scene_dicom.toml" --out "$work/ct" --quiet >/dev/null 2>"$work/ct_foreign.err" \
+   && grep -q "holds 'notes.txt', which is not a slice" "$work/ct_foreign.err" \
+   && [ "$(stat -c %i "$work/ct/result.h5")" = "$h5_inode" ]
+then pass "a foreign file in warped_ct_dicom/ stops the rerun before any output is replaced"
+else fail "foreign file in the warped series folder"; cat "$work/ct_foreign.err"; fi
+
+# --- voxbreast phantom: a rerun with another seed replaces all four outputs, its DICOM series whole;
+# a foreign file in dicom/ stops it before any file is replaced.
+ph="$work/phantom"
+if "$bin" phantom --out "$ph" --spacing 6 --seed 1 >/dev/null 2>&1 && cp "$ph/ct.nii.gz" "$work/ph_seed1.nii.gz" \
+   && uid1=$(dcmdump +P 0020,000e "$ph/dicom/CT00001.dcm") \
+   && "$bin" phantom --out "$ph" --spacing 6 --seed 2 >/dev/null 2>&1 \
+   && ! cmp -s "$ph/ct.nii.gz" "$work/ph_seed1.nii.gz" && [ "$(dcmdump +P 0020,000e "$ph/dicom/CT00001.dcm")" != "$uid1" ] \
+   && /usr/bin/python3 - "$ph" <<'PY'
+import sys, glob, numpy as np, nibabel as nib, pydicom
+d = sys.argv[1]
+ct = np.asarray(nib.load(d + "/ct.nii.gz").dataobj)
+files = sorted(glob.glob(d + "/dicom/*.dcm"))
+assert len(files) == ct.shape[2], (len(files), ct.shape)
+s = pydicom.dcmread(files[0])
+assert np.array_equal(s.pixel_array.T * float(s.RescaleSlope) + float(s.RescaleIntercept), ct[:, :, 0]), "dicom/ is seed 2's CT"
+PY
+then pass "phantom rerun into its folder replaces the CT, labels and DICOM series"
+else fail "phantom rerun"; fi
+cp "$ph/ct.nii.gz" "$work/ph_seed2.nii.gz" && touch "$ph/dicom/notes.txt"
+if ! "$bin" phantom --out "$ph" --spacing 6 --seed 3 >/dev/null 2>"$work/ph_foreign.err" \
+   && grep -q "holds 'notes.txt'" "$work/ph_foreign.err" && cmp -s "$ph/ct.nii.gz" "$work/ph_seed2.nii.gz"
+then pass "phantom refuses a foreign file in dicom/ before replacing anything"
+else fail "phantom with a foreign file in dicom/"; cat "$work/ph_foreign.err"; fi
 
 # --- the positioning sample: the phantom prone in a two-ring device (docs/POSITIONING.md)
 if "$bin" simulate "$root/data-samples/phantom/scene_device.toml" --out "$work/device" --quiet >"$work/device.txt" 2>&1 \

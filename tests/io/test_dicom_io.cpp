@@ -470,6 +470,46 @@ TEST(DicomWrite, RefusesNonEmptyFolder) {
   EXPECT_EQ(files_in(out).size(), 6u);
 }
 
+TEST(DicomWrite, ReplaceSwapsAnEarlierSeriesWhole) {
+  TempDir tmp;
+  const fs::path out = tmp / "series";
+  replace_dicom_series(out.string(), oblique_volume(6), "first");  // a new folder
+  ASSERT_EQ(files_in(out).size(), 6u);
+
+  ImageVolume second = oblique_volume(4);  // fewer slices: no slice of the first may survive
+  for (float& v : second.values) v += 100.f;
+  replace_dicom_series(out.string(), second, "second");
+  EXPECT_EQ(files_in(out).size(), 4u);
+  EXPECT_EQ(read_dicom_series(out.string()).values, rounded(second.values));
+  EXPECT_EQ(files_in(tmp.path()).size(), 1u) << "no staging or old folder left behind";
+}
+
+TEST(DicomWrite, ReplaceRefusesAFolderWithOtherFiles) {
+  TempDir tmp;
+  const fs::path out = tmp / "series";
+  replace_dicom_series(out.string(), oblique_volume(3), "x");
+  for (const char* foreign : {"notes.txt", "CT00001.dcm.bak", "sub"}) {
+    const fs::path path = out / foreign;
+    if (std::string(foreign) == "sub") fs::create_directory(path);
+    else std::fclose(std::fopen(path.c_str(), "w"));
+    for (const std::string& message :
+         {error_of([&] { check_dicom_series_replaceable(out.string()); }),
+          error_of([&] { replace_dicom_series(out.string(), oblique_volume(5), "y"); })}) {
+      EXPECT_NE(message.find(std::string("'") + foreign + "'"), std::string::npos) << message;
+      EXPECT_NE(message.find("not a slice of an earlier VoxBreast series"), std::string::npos) << message;
+    }
+    EXPECT_EQ(files_in(out).size(), 4u) << foreign << ": the folder is left as it was";
+    EXPECT_EQ(files_in(tmp.path()).size(), 1u) << foreign << ": no staging folder left behind";
+    fs::remove(path);
+  }
+  check_dicom_series_replaceable(out.string());  // its own series alone is fine
+
+  const fs::path file = tmp / "plain_file";
+  std::fclose(std::fopen(file.c_str(), "w"));
+  EXPECT_NE(error_of([&] { replace_dicom_series(file.string(), oblique_volume(), "x"); }).find("is not a folder"),
+            std::string::npos);
+}
+
 TEST(DicomWrite, RefusesShearedAffine) {
   TempDir tmp;
   ImageVolume v = oblique_volume();
