@@ -7,7 +7,8 @@
 //   voxbreast bench --quick --out out/bench
 //   voxbreast haptic scene.toml --trajectory press.csv --rate-hz 1000 --out out/haptic
 //   voxbreast probe data-samples/palpation/scene.toml --out out/palpation
-// Every subcommand has --help. Errors print one line naming the problem and exit non-zero.
+// Every subcommand has --help. Errors print one line naming the problem and exit non-zero (2 for
+// a misused command line, 1 for everything else).
 #include <CL/opencl.hpp>
 #include <cstdio>
 
@@ -27,7 +28,12 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // A usage error in the same one-line form as every other error, with the help to read.
+    std::string command = "voxbreast";
+    for (const CLI::App* sub : app.get_subcommands()) command += " " + sub->get_name();
+    std::fprintf(stderr, "voxbreast: error: %s (see '%s --help')\n", e.what(), command.c_str());
+    return 2;
   }
   try {
     for (const auto& command : commands)

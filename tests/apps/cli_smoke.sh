@@ -103,6 +103,14 @@ if ! "$bin" phantom --out "$ph" --spacing 6 --seed 3 >/dev/null 2>"$work/ph_fore
 then pass "phantom refuses a foreign file in dicom/ before replacing anything"
 else fail "phantom with a foreign file in dicom/"; cat "$work/ph_foreign.err"; fi
 
+# --- a misused command line: one line in the form of every error, naming the option and the help, exit 2
+"$bin" simulate "$root/data-samples/breast_phantom.toml" --out "$work/usage" --bogus >"$work/usage.out" 2>"$work/usage.err"
+rc=$?
+if [ "$rc" = 2 ] && [ "$(wc -l <"$work/usage.err")" = 1 ] && [ ! -s "$work/usage.out" ] && [ ! -e "$work/usage" ] \
+   && grep -q "^voxbreast: error: .*--bogus (see 'voxbreast simulate --help')$" "$work/usage.err"
+then pass "usage error: $(cat "$work/usage.err")"
+else fail "usage error (rc $rc)"; cat "$work/usage.out" "$work/usage.err"; fi
+
 # --- the positioning sample: the phantom prone in a two-ring device (docs/POSITIONING.md)
 if "$bin" simulate "$root/data-samples/phantom/scene_device.toml" --out "$work/device" --quiet >"$work/device.txt" 2>&1 \
    && grep -q "wrote .*metrics.csv" "$work/device.txt" && python3 - "$work/device" <<'PY'
