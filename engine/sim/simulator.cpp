@@ -418,6 +418,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     // u and the lattice force at the previous check; zero = the rest state, where both are zero
     std::vector<char> zeros(2 * 4 * real_size_ * n_, 0);
     relax_prev_ = cl::Buffer(cl.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, zeros.size(), zeros.data());
+    relax_prev_valid_ = relax_from_rest_valid_;  // zero force at rest only while the held elements are there
     check_.setArg(relax_arg + 1, relax_prev_);
     set_real(relax_kernel_, kStepIndenter + kIndenterArgs + 3, damping_);
   }
@@ -574,6 +575,11 @@ void Simulator::set_rest_offsets(const std::vector<double>& u0) {
     // 2n vectors (u0_e, 0): write_xyz takes them like any other list of vectors
     if (precision_ == Precision::Double) write_xyz<double>(relax_prev_, prev, nullptr);
     else write_xyz<float>(relax_prev_, prev, nullptr);
+    held_u0_.clear();
+    for (std::size_t e = 0; e < n_; ++e)
+      if (inverse_mass_[e] == 0) held_u0_.insert(held_u0_.end(), {u0[3 * e], u0[3 * e + 1], u0[3 * e + 2]});
+    update_relax_from_rest();
+    relax_prev_valid_ = relax_from_rest_valid_;
   }
   if (volume_) {  // the constraint holds the unloaded state's volume
     std::vector<double> rest = element_positions_m(lattice_), unloaded = rest;
@@ -1217,8 +1223,11 @@ void Simulator::adapt_relaxation_damping(const std::vector<double>& partial) {
   for (std::size_t g = 0; g < check_groups_; ++g)
     for (int k = 0; k < 4; ++k) sum[k] += partial[g * check_slots_ + R + k];
   double omega_sq = relax_omega_sq_;
-  for (int k : {0, 2})
-    if (sum[k] > 0 && sum[k + 1] > 0) omega_sq = std::min(omega_sq, sum[k] / sum[k + 1]);
+  for (int k : {0, 2}) {
+    const bool valid = k == 0 ? relax_from_rest_valid_ : relax_prev_valid_;
+    if (valid && sum[k] > 0 && sum[k + 1] > 0) omega_sq = std::min(omega_sq, sum[k] / sum[k + 1]);
+  }
+  relax_prev_valid_ = true;  // the check kernel stored this state for the next check
   if (!std::isfinite(omega_sq)) return;  // no displacement yet: keep c
   relax_omega_sq_ = omega_sq;
   damping_ = std::min(2 * std::sqrt(omega_sq), 0.5 / dt_.dt_s);
@@ -1305,6 +1314,19 @@ void Simulator::upload(const std::vector<double>& u, const std::vector<double>& 
     write_xyz<float>(v_, v, nullptr);
   }
   if (lanes_ || step_list_) mirror_state();
+  if (relax_) {
+    held_u_.clear();
+    for (std::size_t e = 0; e < n_; ++e)
+      if (inverse_mass_[e] == 0) held_u_.insert(held_u_.end(), {u[3 * e], u[3 * e + 1], u[3 * e + 2]});
+    update_relax_from_rest();
+    relax_prev_valid_ = false;  // relax_prev_ holds a state before this one, of another run
+  }
+}
+
+void Simulator::update_relax_from_rest() {
+  relax_from_rest_valid_ = true;
+  for (std::size_t i = 0; i < held_u_.size(); ++i)
+    if (std::abs(held_u_[i] - (held_u0_.empty() ? 0.0 : held_u0_[i])) > 1e-9) relax_from_rest_valid_ = false;
 }
 
 void Simulator::mirror_state() {

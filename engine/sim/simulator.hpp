@@ -298,6 +298,13 @@ class Simulator {
   bool relax_ = false;
   double damping_ = 0;  ///< global damping (1/s); adapted at each check when relaxing
   double relax_omega_sq_ = INFINITY;  ///< relaxation: smallest Rayleigh quotient so far (1/s²)
+  // A Rayleigh quotient bounds ω_min² only for a displacement that vanishes on the held elements:
+  // u from rest while they sit at rest (not under a posed anchor, whose rigid turn has no energy),
+  // and the change since the previous check of the same run (not across an upload).
+  bool relax_from_rest_valid_ = true;
+  bool relax_prev_valid_ = false;
+  std::vector<double> held_u_, held_u0_;  ///< relaxation: the held elements' u and rest offset (m)
+  void update_relax_from_rest();
   Vec3 gravity_ = Vec3::Zero();
   cl::Buffer relax_scale_, relax_prev_;
   bool rest_offsets_ = false;
