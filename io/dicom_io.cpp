@@ -1153,25 +1153,6 @@ fs::path clean_output_path(const std::string& dir) {
   return path;
 }
 
-/// A folder this writer may replace whole: absent, or holding only regular files named as
-/// slice_file_name names them (an earlier series of this writer). Returns whether it exists.
-bool check_own_series_folder(const fs::path& path, const std::string& dir) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return false;
-  require(fs::is_directory(path, ec) && !fs::is_symlink(path, ec), "the output path exists and is not a folder",
-          dir, "remove it or choose another output folder");
-  for (const fs::directory_entry& entry : fs::directory_iterator(path, ec)) {
-    const std::string name = entry.path().filename().string();
-    const bool slice_name = name.size() == 11 && name.rfind("CT", 0) == 0 && name.substr(7) == ".dcm" &&
-                            std::all_of(name.begin() + 2, name.begin() + 7, [](char c) { return c >= '0' && c <= '9'; });
-    require(slice_name && entry.is_regular_file(ec) && !entry.is_symlink(ec),
-            "the output folder holds '" + name + "', which is not a slice of an earlier VoxBreast series", dir,
-            "a DICOM series replaces only its own earlier series: move it away or choose another output folder");
-  }
-  require(!ec, "cannot list the output folder: " + ec.message(), dir);
-  return true;
-}
-
 void check_writable(const ImageVolume& ct, const std::string& dir) {
   require(ct.dims[0] > 0 && ct.dims[1] > 0 && ct.dims[2] > 0, "the volume is empty", dir);
   require(ct.dims[0] <= 65535 && ct.dims[1] <= 65535,
@@ -1186,6 +1167,26 @@ std::string slice_file_name(int k) {
   char name[32];
   std::snprintf(name, sizeof name, "CT%05d.dcm", k + 1);
   return name;
+}
+
+/// A folder this writer may replace whole: absent, or holding only regular files named as
+/// slice_file_name names them (an earlier series of this writer). Returns whether it exists.
+bool check_own_series_folder(const fs::path& path, const std::string& dir) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return false;
+  require(fs::is_directory(path, ec) && !fs::is_symlink(path, ec), "the output path exists and is not a folder",
+          dir, "remove it or choose another output folder");
+  for (const fs::directory_entry& entry : fs::directory_iterator(path, ec)) {
+    const std::string name = entry.path().filename().string();
+    int number = 0;  // exactly the name slice_file_name gives some slice
+    const bool slice_name = std::sscanf(name.c_str(), "CT%5d", &number) == 1 && number >= 1 &&
+                            slice_file_name(number - 1) == name;
+    require(slice_name && entry.is_regular_file(ec) && !entry.is_symlink(ec),
+            "the output folder holds '" + name + "', which is not a slice of an earlier VoxBreast series", dir,
+            "a DICOM series replaces only its own earlier series: move it away or choose another output folder");
+  }
+  require(!ec, "cannot list the output folder: " + ec.message(), dir);
+  return true;
 }
 
 /// read_dicom_series without its guard against running out of memory.

@@ -65,10 +65,10 @@ else fail "NIfTI vs DICOM"; fi
 if dcmdump "$work/ct/warped_ct_dicom/CT00001.dcm" >/dev/null 2>&1; then pass "warped CT DICOM readable by dcmdump"; else fail "warped CT DICOM"; fi
 # A rerun into the same folder replaces its own warped series whole (a new series UID, no
 # leftovers); a file of someone else's in that folder stops the rerun before it computes.
-series_uid() { dcmdump +P 0020,000e "$1/warped_ct_dicom/CT00001.dcm" 2>/dev/null; }
-first_uid=$(series_uid "$work/ct"); slices=$(ls "$work/ct/warped_ct_dicom" | wc -l)
+series_uid() { dcmdump +P 0020,000e "$1/CT00001.dcm" 2>/dev/null; }  # of the series in folder $1
+first_uid=$(series_uid "$work/ct/warped_ct_dicom"); slices=$(ls "$work/ct/warped_ct_dicom" | wc -l)
 if "$bin" simulate "$root/data-samples/phantom/scene_dicom.toml" --out "$work/ct" --quiet >/dev/null 2>&1 \
-   && [ -n "$first_uid" ] && [ "$(series_uid "$work/ct")" != "$first_uid" ] \
+   && [ -n "$first_uid" ] && [ "$(series_uid "$work/ct/warped_ct_dicom")" != "$first_uid" ] \
    && [ "$(ls "$work/ct/warped_ct_dicom" | wc -l)" = "$slices" ] && [ -z "$(ls -A "$work/ct" | grep '^\.')" ]
 then pass "a rerun into the same folder replaces its warped CT series"
 else fail "rerun replaces the warped series"; fi
@@ -83,9 +83,9 @@ else fail "foreign file in the warped series folder"; cat "$work/ct_foreign.err"
 # a foreign file in dicom/ stops it before any file is replaced.
 ph="$work/phantom"
 if "$bin" phantom --out "$ph" --spacing 6 --seed 1 >/dev/null 2>&1 && cp "$ph/ct.nii.gz" "$work/ph_seed1.nii.gz" \
-   && uid1=$(dcmdump +P 0020,000e "$ph/dicom/CT00001.dcm") \
+   && uid1=$(series_uid "$ph/dicom") && [ -n "$uid1" ] \
    && "$bin" phantom --out "$ph" --spacing 6 --seed 2 >/dev/null 2>&1 \
-   && ! cmp -s "$ph/ct.nii.gz" "$work/ph_seed1.nii.gz" && [ "$(dcmdump +P 0020,000e "$ph/dicom/CT00001.dcm")" != "$uid1" ] \
+   && ! cmp -s "$ph/ct.nii.gz" "$work/ph_seed1.nii.gz" && [ "$(series_uid "$ph/dicom")" != "$uid1" ] \
    && /usr/bin/python3 - "$ph" <<'PY'
 import sys, glob, numpy as np, nibabel as nib, pydicom
 d = sys.argv[1]
