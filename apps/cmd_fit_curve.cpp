@@ -47,8 +47,8 @@ int run_fit_curve(const FitCurveCliOptions& o) {
   const Scene scene = load_scene(o.scene, o.precision);
   const ForceCurve curve = force_curve_from_rows(read_numeric_csv(o.curve, {"displacement_mm", "force_n"}), o.curve);
   const OutputDir output_dir(o.out);
-  const PreparedModel model = prepare_model(scene);
   const ClContext cl(select_device(o.device));
+  const PreparedModel model = prepare_model(scene, &cl.info);
   CurveFitOptions options;
   options.tissue = o.tissue;
   options.parameters = o.params;

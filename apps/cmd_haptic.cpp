@@ -26,8 +26,8 @@ int run_haptic(const HapticCliOptions& o) {
   const ProbeTrajectory trajectory = trajectory_from_rows(
       read_numeric_csv(o.trajectory, {"time_s", "x_mm", "y_mm", "z_mm"}), o.trajectory);
   const OutputDir output_dir(o.out);
-  const PreparedModel model = prepare_model(scene);
   const ClContext cl(select_device(o.device));
+  const PreparedModel model = prepare_model(scene, &cl.info);
   HapticOptions options;
   options.probe = std::size_t(o.probe - 1);
   options.steps_per_update = o.steps_per_update;

@@ -25,7 +25,7 @@ int run_probe(const ProbeOptions& o) {
   require(scene.probe.active, "the scene has no [probe] section", o.scene, "add [probe] (docs/SCENE.md)");
   const OutputDir output_dir(o.out);
   const ClContext cl(select_device(o.device));
-  const PreparedModel model = prepare_model(scene);
+  const PreparedModel model = prepare_model(scene, &cl.info);
   Simulator sim(scene, model.lattice, model.elements, cl);
   if (!o.quiet)
     std::fprintf(stderr, "voxbreast: %zu elements, dt = %.3g s, device %s; %d presses of %d increments\n",

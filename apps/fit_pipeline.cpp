@@ -228,7 +228,7 @@ std::string fingerprint(const Scene& scene) {
 json fit_scene(const Scene& scene, const ClContext& cl, const std::string& dir, const FitRunOptions& options) {
   const FitSpec fit = parse_fit_section(scene.source_text, scene.source_path);
   ensure_output_dir(dir);
-  const PreparedModel model = prepare_model(scene);
+  const PreparedModel model = prepare_model(scene, &cl.info);
   const FitRegions regions = make_fit_regions(fit, scene, model.lattice);
   const ForwardModel forward(scene, model.lattice, regions, fit, cl);
   std::optional<Observation> obs;  // displacements, or
@@ -444,7 +444,7 @@ double largest_displacement_m(const std::vector<double>& change) {
 }  // namespace
 
 double write_synthetic_labels(const Scene& scene, const ClContext& cl, const std::string& path, int subdivide) {
-  const PreparedModel model = prepare_model(scene);
+  const PreparedModel model = prepare_model(scene, &cl.info);
   const Lattice& lattice = model.lattice;
   const std::vector<double> change = true_change_m(scene, cl, lattice);
   std::vector<int> value_of_tissue(lattice.tissue_names.size());
@@ -463,7 +463,7 @@ double write_synthetic_labels(const Scene& scene, const ClContext& cl, const std
 }
 
 double write_synthetic_surface(const Scene& scene, const ClContext& cl, const std::string& path, int label_value) {
-  const PreparedModel model = prepare_model(scene);
+  const PreparedModel model = prepare_model(scene, &cl.info);
   const std::vector<SurfaceRegion> region = surface_regions(scene, model.lattice, {label_value}, "--surface-label");
   const std::vector<double> change = true_change_m(scene, cl, model.lattice);
   write_triangle_mesh_stl(path, deformed_boundary_mesh(model.lattice, change, region[0].tissue));
@@ -472,7 +472,7 @@ double write_synthetic_surface(const Scene& scene, const ClContext& cl, const st
 
 double write_synthetic_observation(const Scene& scene, const ClContext& cl, const std::string& path, double noise_m,
                                    std::uint64_t seed) {
-  const PreparedModel model = prepare_model(scene);
+  const PreparedModel model = prepare_model(scene, &cl.info);
   const Lattice& lattice = model.lattice;
   const std::vector<double> change = true_change_m(scene, cl, lattice);
   std::mt19937_64 random(seed);

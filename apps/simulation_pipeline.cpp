@@ -48,7 +48,7 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
           "the [probe] indenter has no start, so only 'voxbreast probe' can run this scene", "probe.indenter",
           "run voxbreast probe, or give the indenter a start");
   std::unique_lock io(file_io_mutex());
-  const PreparedModel model = prepare_model(scene);
+  const PreparedModel model = prepare_model(scene, &cl.info);
   if (options.full_outputs && model.ct && scene.output.warped_ct_dicom)  // refuse before the run, not after it
     check_dicom_series_replaceable(out_dir + "/warped_ct_dicom");
   io.unlock();

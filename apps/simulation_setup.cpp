@@ -5,6 +5,7 @@
 
 #include "engine/image/image_lattice.hpp"
 #include "engine/lattice/voxelise.hpp"
+#include "engine/sim/simulator.hpp"
 #include "io/dicom_io.hpp"
 #include "io/nifti_io.hpp"
 #include "io/scene_file.hpp"
@@ -45,7 +46,7 @@ void warn_implausible_moduli(const Scene& scene, const Lattice& lattice, std::ve
 
 }  // namespace
 
-PreparedModel prepare_model(const Scene& scene) {
+PreparedModel prepare_model(const Scene& scene, const DeviceInfo* device) {
   PreparedModel m;
   if (scene.model.from_image()) {
     m.ct = load_ct(scene.model, m.warnings);
@@ -56,6 +57,7 @@ PreparedModel prepare_model(const Scene& scene) {
   } else {
     m.lattice = build_lattice(voxelise_shapes(scene), scene.model.downsample);
   }
+  if (device) check_lattice_fits_device(scene, m.lattice, *device);
   m.elements = make_element_arrays(scene, m.lattice);
   warn_implausible_moduli(scene, m.lattice, m.warnings);
   return m;

@@ -8,6 +8,7 @@
 #include "engine/lattice/lattice.hpp"
 #include "engine/scene/scene.hpp"
 #include "engine/sim/element_setup.hpp"
+#include "engine/sim/opencl_runtime.hpp"
 
 namespace vb::app {
 
@@ -24,7 +25,8 @@ struct PreparedModel {
 /// Reads a CT: a folder is a DICOM series, a file is NIfTI.
 ImageVolume load_ct(const ModelSpec& model, std::vector<std::string>& warnings);
 
-/// Builds the lattice from shapes or from the CT (+ labels) and the per-element arrays.
-PreparedModel prepare_model(const Scene& scene);
+/// Builds the lattice from shapes or from the CT (+ labels) and the per-element arrays. With a
+/// `device`, a lattice too large for it is refused before its arrays are built.
+PreparedModel prepare_model(const Scene& scene, const DeviceInfo* device = nullptr);
 
 }  // namespace vb::app

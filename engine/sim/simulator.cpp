@@ -116,7 +116,44 @@ std::vector<cl_uint> elements_read_by_free(const Lattice& lattice, const std::ve
   return list;
 }
 
+
+/// Smallest downsample factor f above the scene's own, d, whose model (about bytes·(d/f)³) fits
+/// the device.
+int fitting_downsample(std::size_t bytes, int d, const DeviceInfo& device) {
+  const double budget = 0.9 * double(device.global_memory_bytes);
+  int f = d + 1;
+  while (double(bytes) * std::pow(double(d) / f, 3) > budget && f < 64) ++f;
+  return f;
+}
+
 }  // namespace
+
+void require_fits_device(std::size_t device_bytes, std::size_t largest_buffer_bytes, const Scene& scene,
+                         const DeviceInfo& device) {
+  require(double(device_bytes) < 0.9 * double(device.global_memory_bytes) &&
+              largest_buffer_bytes <= device.max_allocation_bytes,
+          "the model needs " + mib(double(device_bytes)) + " of device memory but '" + device.name + "' has " +
+              mib(double(device.global_memory_bytes)) + " (largest buffer " +
+              mib(double(device.max_allocation_bytes)) + ")",
+          "model",
+          "set model.downsample to at least " + std::to_string(fitting_downsample(device_bytes, scene.model.downsample, device)) +
+              ", crop the model (model.roi_min/max, model.keep)" +
+              (scene.solver.precision == Precision::Double ? ", or use float precision" : ""));
+}
+
+void check_lattice_fits_device(const Scene& scene, const Lattice& lattice, const DeviceInfo& device) {
+  bool hyperelastic = false;  // as make_element_arrays decides it, from the tissues present
+  for (const std::string& tissue : lattice.tissue_names) {
+    const auto it = scene.materials.find(tissue);
+    hyperelastic = hyperelastic || (it != scene.materials.end() && !it->second.rigid && it->second.law != "linear" &&
+                                    it->second.law != "biphasic");
+  }
+  const std::size_t n = lattice.element_count();
+  const std::size_t cells = padded_grid_shape(lattice).cells;
+  const std::size_t real = scene.solver.precision == Precision::Double ? 8 : 4;
+  require_fits_device(estimated_device_bytes(n, cells, scene.solver.precision, hyperelastic),
+                      std::max((hyperelastic ? 3 : 1) * 4 * real * n, cells * sizeof(cl_int)), scene, device);
+}
 
 std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision, bool hyperelastic) {
   const std::size_t real = precision == Precision::Double ? 8 : 4;
@@ -134,17 +171,6 @@ std::size_t estimated_volume_device_bytes(std::size_t elements, std::size_t surf
          + (groups * kVolumeSlots + kVolumeScalars) * real;
 }
 
-namespace {
-
-/// Smallest downsample factor f whose model (about bytes/f³) fits the device.
-int fitting_downsample(std::size_t bytes, const DeviceInfo& device) {
-  const double budget = 0.9 * double(device.global_memory_bytes);
-  int f = 2;
-  while (double(bytes) / (f * f * f) > budget && f < 64) ++f;
-  return f;
-}
-
-}  // namespace
 
 Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const ClContext& cl)
     : scene_(scene),
@@ -210,13 +236,8 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   hyper_ = el.hyperelastic;
   plan_launches(scene, el, cl);
   if (stress_pair_) device_bytes_ += n_ * 4 * 4 * real_size_;  // the predicted stage's Q rows and C
-  require(double(device_bytes_) < 0.9 * double(cl.info.global_memory_bytes) &&
-              std::max((el.hyperelastic ? 3 : 1) * state_bytes, cells * sizeof(cl_int)) <= cl.info.max_allocation_bytes,
-          "the model needs " + mib(double(device_bytes_)) + " of device memory but '" + cl.info.name +
-              "' has " + mib(double(cl.info.global_memory_bytes)) + " (largest buffer " +
-              mib(double(cl.info.max_allocation_bytes)) + ")",
-          "model", "set model.downsample to at least " + std::to_string(fitting_downsample(device_bytes_, cl.info)) +
-                       ", crop the model (model.roi_min/max, model.keep), or use float precision");
+  require_fits_device(device_bytes_, std::max((el.hyperelastic ? 3 : 1) * state_bytes, cells * sizeof(cl_int)),
+                      scene, cl.info);
 
   const PaddedGrid padded = make_padded_grid(lattice);
   const std::vector<cl_int>& grid = padded.element_of_cell;

@@ -111,6 +111,33 @@ TEST(OpenCLRuntime, ModelTooLargeForDeviceIsRefused) {
   }
 }
 
+// The lattice alone is enough to refuse a model far too large for the device (before its arrays
+// are built), with the same message as the Simulator's; the hint's downsample is above the
+// scene's own and suggests float only to a double run.
+TEST(OpenCLRuntime, LatticeTooLargeForDeviceIsRefusedBeforeItsArrays) {
+  DeviceInfo info = test::cl_context().info;
+  info.global_memory_bytes = 1 << 18;  // 256 KiB "device"
+  Scene s = test::box_scene(40, 40, 40, 0.002);
+  s.model.downsample = 2;
+  const Lattice lattice = test::make_model(s).lattice;  // 20³ elements: ~620 KB in float
+  const auto message = [&](Precision p) {
+    s.solver.precision = p;
+    try {
+      check_lattice_fits_device(s, lattice, info);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string in_float = message(Precision::Float);
+  EXPECT_NE(in_float.find("of device memory"), std::string::npos) << in_float;
+  EXPECT_NE(in_float.find("model.downsample to at least 3"), std::string::npos) << in_float;  // 620 KB·(2/3)³ fits
+  EXPECT_EQ(in_float.find("float precision"), std::string::npos) << in_float;
+  EXPECT_NE(message(Precision::Double).find("or use float precision"), std::string::npos);
+  info.global_memory_bytes = std::uint64_t(1) << 30;
+  EXPECT_EQ(message(Precision::Float), "no error");
+}
+
 // The state (u, v, the predicted stage, …) is one buffer (Simulator::state_): a device whose
 // largest allocation is below it refuses the model by name, even with memory to spare.
 TEST(OpenCLRuntime, StateLargerThanTheLargestAllocationIsRefused) {
