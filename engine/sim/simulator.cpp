@@ -116,7 +116,6 @@ std::vector<cl_uint> elements_read_by_free(const Lattice& lattice, const std::ve
   return list;
 }
 
-
 /// Smallest downsample factor f above the scene's own, d, whose model (about bytes·(d/f)³) fits
 /// the device.
 int fitting_downsample(std::size_t bytes, int d, const DeviceInfo& device) {
@@ -136,7 +135,8 @@ void require_fits_device(std::size_t device_bytes, std::size_t largest_buffer_by
               mib(double(device.global_memory_bytes)) + " (largest buffer " +
               mib(double(device.max_allocation_bytes)) + ")",
           "model",
-          "set model.downsample to at least " + std::to_string(fitting_downsample(device_bytes, scene.model.downsample, device)) +
+          "set model.downsample to at least " +
+              std::to_string(fitting_downsample(device_bytes, scene.model.downsample, device)) +
               ", crop the model (model.roi_min/max, model.keep)" +
               (scene.solver.precision == Precision::Double ? ", or use float precision" : ""));
 }
@@ -170,7 +170,6 @@ std::size_t estimated_volume_device_bytes(std::size_t elements, std::size_t surf
          + elements * 4 * real                   // gradient per element
          + (groups * kVolumeSlots + kVolumeScalars) * real;
 }
-
 
 Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const ClContext& cl)
     : scene_(scene),
