@@ -63,11 +63,7 @@ std::vector<double> block(const std::vector<double>& state, std::size_t k, std::
 std::size_t ForwardModel::batch_size() const {
   if (fit_.batch == 1 || unloaded_ || scene_.volume.preserve || scene_.reference_state.active) return 1;
   const Lattice& lat = lattice();
-  bool hyper = false;  // as make_element_arrays decides: a tissue table row per copy
-  for (const std::string& t : lat.tissue_names) {
-    const MaterialSpec& m = scene_.materials.at(t);
-    hyper = hyper || (!m.rigid && m.law != "linear" && m.law != "biphasic");
-  }
+  const bool hyper = has_hyperelastic_tissue(scene_, lat);  // a tissue table row per copy
   std::size_t most = hyper ? 256 / std::max<std::size_t>(1, lat.tissue_names.size()) : 256;
   if (fit_.batch > 1) {
     require(std::size_t(fit_.batch) <= most,

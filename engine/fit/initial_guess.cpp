@@ -65,7 +65,7 @@ std::vector<double> element_hu(const Lattice& lattice, const ImageVolume& ct) {
 }
 
 double material_modulus_pa(const MaterialSpec& m) {
-  if (m.law == "linear" || m.law == "biphasic" || m.rigid) return m.youngs_modulus_pa;
+  if (!m.hyperelastic()) return m.youngs_modulus_pa;
   // Hyperelastic: the small-strain E = 9κμ₀/(3κ + μ₀) of the law (for neo-Hookean with κ from ν
   // this is E itself).
   if (m.law == "neo-hookean" && m.bulk_modulus_pa <= 0) return m.youngs_modulus_pa;

@@ -6,7 +6,7 @@ namespace vb {
 
 MaterialSpec material_with_modulus(const MaterialSpec& m, double E) {
   MaterialSpec out = m;
-  if (m.law == "linear" || m.law == "biphasic" || m.rigid) {
+  if (!m.hyperelastic()) {
     out.youngs_modulus_pa = E;
     return out;
   }

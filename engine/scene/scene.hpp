@@ -70,6 +70,8 @@ struct MaterialSpec {
 
   /// Whether the law is parametrised by Young's modulus E (the others by c10, or μ and α).
   bool law_takes_E() const { return law == "linear" || law == "biphasic" || law == "neo-hookean"; }
+  /// Whether the tissue steps by a hyperelastic law (rigid tissue and springs do not).
+  bool hyperelastic() const { return !rigid && law != "linear" && law != "biphasic"; }
 };
 
 /// Relaxation: dynamic relaxation for the static answer only (fictitious masses and damping;

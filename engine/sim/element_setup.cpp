@@ -9,6 +9,14 @@
 
 namespace vb {
 
+bool has_hyperelastic_tissue(const Scene& scene, const Lattice& lattice) {
+  for (const std::string& tissue : lattice.tissue_names) {
+    const auto it = scene.materials.find(tissue);
+    if (it != scene.materials.end() && it->second.hyperelastic()) return true;
+  }
+  return false;
+}
+
 ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
   const std::size_t n = lattice.element_count();
   require(n > 0, "the model has no elements", "model", "check the shapes, labels and downsample factor");

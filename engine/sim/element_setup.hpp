@@ -32,4 +32,8 @@ struct ElementArrays {
 /// material, a modulus or density is not positive, or an anchor holds nothing.
 ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice);
 
+/// Whether some tissue of the lattice is hyperelastic (ElementArrays::hyperelastic, without the
+/// arrays); a tissue without a material counts as not.
+bool has_hyperelastic_tissue(const Scene& scene, const Lattice& lattice);
+
 }  // namespace vb

@@ -125,10 +125,13 @@ int fitting_downsample(std::size_t bytes, int d, const DeviceInfo& device) {
   return f;
 }
 
-}  // namespace
-
-void require_fits_device(std::size_t device_bytes, std::size_t largest_buffer_bytes, const Scene& scene,
-                         const DeviceInfo& device) {
+/// Refuses a model of `device_bytes` (n elements, a padded grid of `cells`) that does not fit
+/// `device`: its largest buffers are the state arena (3 state vectors' worth with the stress
+/// rows of hyperelastic tissue) and the grid.
+void require_fits_device(std::size_t device_bytes, std::size_t n, std::size_t cells, bool hyperelastic,
+                         const Scene& scene, const DeviceInfo& device) {
+  const std::size_t state_bytes = 4 * (scene.solver.precision == Precision::Double ? 8 : 4) * n;
+  const std::size_t largest_buffer_bytes = std::max((hyperelastic ? 3 : 1) * state_bytes, cells * sizeof(cl_int));
   require(double(device_bytes) < 0.9 * double(device.global_memory_bytes) &&
               largest_buffer_bytes <= device.max_allocation_bytes,
           "the model needs " + mib(double(device_bytes)) + " of device memory but '" + device.name + "' has " +
@@ -141,18 +144,14 @@ void require_fits_device(std::size_t device_bytes, std::size_t largest_buffer_by
               (scene.solver.precision == Precision::Double ? ", or use float precision" : ""));
 }
 
+}  // namespace
+
 void check_lattice_fits_device(const Scene& scene, const Lattice& lattice, const DeviceInfo& device) {
-  bool hyperelastic = false;  // as make_element_arrays decides it, from the tissues present
-  for (const std::string& tissue : lattice.tissue_names) {
-    const auto it = scene.materials.find(tissue);
-    hyperelastic = hyperelastic || (it != scene.materials.end() && !it->second.rigid && it->second.law != "linear" &&
-                                    it->second.law != "biphasic");
-  }
+  const bool hyperelastic = has_hyperelastic_tissue(scene, lattice);
   const std::size_t n = lattice.element_count();
   const std::size_t cells = padded_grid_shape(lattice).cells;
-  const std::size_t real = scene.solver.precision == Precision::Double ? 8 : 4;
-  require_fits_device(estimated_device_bytes(n, cells, scene.solver.precision, hyperelastic),
-                      std::max((hyperelastic ? 3 : 1) * 4 * real * n, cells * sizeof(cl_int)), scene, device);
+  require_fits_device(estimated_device_bytes(n, cells, scene.solver.precision, hyperelastic), n, cells, hyperelastic,
+                      scene, device);
 }
 
 std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision, bool hyperelastic) {
@@ -235,8 +234,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   hyper_ = el.hyperelastic;
   plan_launches(scene, el, cl);
   if (stress_pair_) device_bytes_ += n_ * 4 * 4 * real_size_;  // the predicted stage's Q rows and C
-  require_fits_device(device_bytes_, std::max((el.hyperelastic ? 3 : 1) * state_bytes, cells * sizeof(cl_int)),
-                      scene, cl.info);
+  require_fits_device(device_bytes_, n_, cells, el.hyperelastic, scene, cl.info);
 
   const PaddedGrid padded = make_padded_grid(lattice);
   const std::vector<cl_int>& grid = padded.element_of_cell;

@@ -68,14 +68,10 @@ struct StateCheck {
 /// (hyperelastic models also store Q and C = FᵀF per element).
 std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision,
                                    bool hyperelastic = false);
-/// Refuses (vb::Error naming the model, the need and the device) a model of `device_bytes` whose
-/// largest buffer is `largest_buffer_bytes` that does not fit `device`, with a downsample factor
-/// that would fit.
-void require_fits_device(std::size_t device_bytes, std::size_t largest_buffer_bytes, const Scene& scene,
-                         const DeviceInfo& device);
-/// The same refusal from the lattice alone, before the per-element arrays are built: a model far
-/// too large for the device is refused in the seconds its lattice takes, not the minutes and
-/// host memory its arrays would (the Simulator checks again with every buffer counted).
+/// Refuses (vb::Error naming the model, its need, the device and a downsample factor that would
+/// fit) a model too large for `device` from its lattice alone, before the per-element arrays are
+/// built: in the time the lattice takes, not the minutes and host memory the arrays would (the
+/// Simulator checks again with every buffer counted).
 void check_lattice_fits_device(const Scene& scene, const Lattice& lattice, const DeviceInfo& device);
 /// Extra device bytes of the volume constraint (kernels/volume.cl): triangles, the per-surface-
 /// element CSR of incident triangle corners, the gradient (per element) and the partial sums.
