@@ -56,7 +56,7 @@ libs=(-ldcmjpls -ldcmjpeg -ldcmimage -ldcmimgle -ldcmdata -loflog -lofstd
 common_sources=(engine/error.cpp io/atomic_file.cpp)
 declare -A target_sources=(
   [fuzz_nifti]="tests/fuzz/fuzz_nifti.cpp io/nifti_io.cpp"
-  [fuzz_dicom_series]="tests/fuzz/fuzz_dicom_series.cpp io/dicom_io.cpp"
+  [fuzz_dicom_series]="tests/fuzz/fuzz_dicom_series.cpp io/dicom_read.cpp io/dicom_pixels.cpp io/dicom_deflate.cpp io/dicom_attributes.cpp"
 )
 declare -A target_corpus=([fuzz_nifti]=nifti [fuzz_dicom_series]=dicom)
 for t in $targets; do
