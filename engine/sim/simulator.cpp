@@ -1,14 +1,14 @@
 #include "engine/sim/simulator.hpp"
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 
-#include "engine/device/torus.hpp"
 #include "engine/error.hpp"
 #include "engine/sim/correct_order.hpp"
+#include "engine/sim/device_memory.hpp"
+#include "engine/sim/kernel_arg_layout.hpp"
 #include "engine/sim/kernel_tables.hpp"
 #include "engine/sim/padded_grid.hpp"
 #include "engine/sim/step_list_rule.hpp"
@@ -16,7 +16,6 @@
 #include "engine/sim/triangle_contact.hpp"
 #include "engine/sim/uniform_neighbourhood.hpp"
 #include "engine/surface/enclosed_volume.hpp"
-#include "engine/surface/surface_area.hpp"
 
 namespace vb {
 namespace {
@@ -29,64 +28,8 @@ std::vector<cl_uint> free_elements(const std::vector<double>& inverse_mass) {
   return list;
 }
 
-constexpr int kCheckWorkGroup = 128;
-// volume_project's work-groups on GPUs (kernels/volume.cl): its last group applies the projection
-// to the whole surface, so wide groups keep that tail short
-constexpr std::size_t kVolumeGpuWorkGroup = 512;
-// VB_SPLIT (kernels/integrate.cl): work-group size of the split Heun kernels, and the model size
-// up to which GPUs split: Ogden on the H200 gained 3–9% at 36k and 76k, lost 4.5% at 125k (cube)
-// and 13.5% at 262k (cube), 6–23% at 147k–246k (phantom; docs/PERF_NOTES.md change 24)
-constexpr std::size_t kSplitWorkGroup = 128, kSplitMaxElements = 98304;
-// Spring models up to this size take Heun's one-launch step on NVIDIA (kernels/persistent.cl):
-// up to 43k cubes it held ~70k steps/s in every round while the launched step, host-bound there,
-// ranged 60–78k (level in the mean); at 47k the launched step won by 3%, at 64k–216k by 26–53%
-// (H200; docs/PERF_NOTES.md changes 24 and 25).
-constexpr std::size_t kPersistentMaxElements = 45056;
-constexpr int kCheckBaseSlots = 5, kCheckSlotsPerIndenter = 4;  // kernels/checks.cl
-constexpr int kCheckSlotsPerTorus = 8;                             // VB_TORUS_SLOTS
-constexpr int kIndenterStride = 20;                                // VB_IND_STRIDE
-constexpr int kTorusStride = 12;                                   // VB_TORUS_STRIDE
-// Kernel argument layout (kernels/common.cl): VB_LATTICE_KERNEL_PARAMS (the arena, its offsets,
-// then the scalars; gravity 7th) then VB_INDENTER_PARAMS.
-constexpr int kLatticeArgs = 10, kLatticeGravity = 6, kIndenterArgs = 3;
-constexpr int kStepLattice = 4;  // step kernels: the 4 state arrays' offsets first (the state arena last)
-constexpr int kStepIndenter = kStepLattice + kLatticeArgs;   // then dt, n
-constexpr int kCheckLattice = 2;                             // check_state: u, v first
-constexpr int kCheckIndenter = kCheckLattice + kLatticeArgs; // then partial, partial_arg, n
-// With VB_TRI_CONTACT the stepping and check kernels end with VB_TRI_PARAMS
-// (kernels/triangle_contact.cl): corner forces, CSR start, corners, triangle count.
-constexpr int kTriangleArgs = 4;
-constexpr int kCheckVolume = kCheckIndenter + kIndenterArgs + 3;  // VB_VOLUME: grad, scalars
-// kernels/volume.cl: volume_partials takes u, v, the lattice parameters, then these.
-constexpr int kVolumeSlots = 5, kVolumeScalars = 5;  // scalars: λ, μ, V, p, M (kernels/volume.cl)
-constexpr int kVolumeMesh = 2 + kLatticeArgs;  // mesh arena, its offsets, n_surf
-constexpr int kVolumeCentre = kVolumeMesh + 3, kVolumeWithForce = kVolumeMesh + 5;
-// volume_project: u, v, the lattice parameters, the mesh, centre, then grad, partial, V0, scalars, count
-constexpr int kProjectGrad = kVolumeCentre + 1, kProjectRestVolume = kVolumeCentre + 3;
-// volume_apply: u, v, mesh arena, its offsets, n_surface, grad, partial, groups, V0, scalars (the
-// state arrays as state arena offsets, the arena last; volume_partials likewise)
-constexpr int kApplyRestVolume = 8;
 
-template <typename T>
-std::vector<T> pack4(const std::vector<double>& xyz, const std::vector<double>* w) {
-  const std::size_t n = xyz.size() / 3;
-  std::vector<T> out(4 * n);
-  for (std::size_t e = 0; e < n; ++e) {
-    for (int c = 0; c < 3; ++c) out[4 * e + c] = static_cast<T>(xyz[3 * e + c]);
-    out[4 * e + 3] = w ? static_cast<T>((*w)[e]) : T(0);
-  }
-  return out;
-}
 
-template <typename T>
-void unpack4(const std::vector<T>& in, std::vector<double>& xyz) {
-  const std::size_t n = in.size() / 4;
-  xyz.resize(3 * n);
-  for (std::size_t e = 0; e < n; ++e)
-    for (int c = 0; c < 3; ++c) xyz[3 * e + c] = static_cast<double>(in[4 * e + c]);
-}
-
-std::string mib(double bytes) { return std::to_string(static_cast<long long>(bytes / (1 << 20))) + " MiB"; }
 
 }  // namespace
 
@@ -116,59 +59,9 @@ std::vector<cl_uint> elements_read_by_free(const Lattice& lattice, const std::ve
   return list;
 }
 
-/// Smallest downsample factor f above the scene's own, d, whose model (about bytes·(d/f)³) fits
-/// the device.
-int fitting_downsample(std::size_t bytes, int d, const DeviceInfo& device) {
-  const double budget = 0.9 * double(device.global_memory_bytes);
-  int f = d + 1;
-  while (double(bytes) * std::pow(double(d) / f, 3) > budget && f < 64) ++f;
-  return f;
-}
-
-/// Refuses a model of `device_bytes` (n elements, a padded grid of `cells`) that does not fit
-/// `device`: its largest buffers are the state arena (3 state vectors' worth with the stress
-/// rows of hyperelastic tissue) and the grid.
-void require_fits_device(std::size_t device_bytes, std::size_t n, std::size_t cells, bool hyperelastic,
-                         const Scene& scene, const DeviceInfo& device) {
-  const std::size_t state_bytes = 4 * (scene.solver.precision == Precision::Double ? 8 : 4) * n;
-  const std::size_t largest_buffer_bytes = std::max((hyperelastic ? 3 : 1) * state_bytes, cells * sizeof(cl_int));
-  require(double(device_bytes) < 0.9 * double(device.global_memory_bytes) &&
-              largest_buffer_bytes <= device.max_allocation_bytes,
-          "the model needs " + mib(double(device_bytes)) + " of device memory but '" + device.name + "' has " +
-              mib(double(device.global_memory_bytes)) + " (largest buffer " +
-              mib(double(device.max_allocation_bytes)) + ")",
-          "model",
-          "set model.downsample to at least " +
-              std::to_string(fitting_downsample(device_bytes, scene.model.downsample, device)) +
-              ", crop the model (model.roi_min/max, model.keep)" +
-              (scene.solver.precision == Precision::Double ? ", or use float precision" : ""));
-}
 
 }  // namespace
 
-void check_lattice_fits_device(const Scene& scene, const Lattice& lattice, const DeviceInfo& device) {
-  const bool hyperelastic = has_hyperelastic_tissue(scene, lattice);
-  const std::size_t n = lattice.element_count();
-  const std::size_t cells = padded_grid_shape(lattice).cells;
-  require_fits_device(estimated_device_bytes(n, cells, scene.solver.precision, hyperelastic), n, cells, hyperelastic,
-                      scene, device);
-}
-
-std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision, bool hyperelastic) {
-  const std::size_t real = precision == Precision::Double ? 8 : 4;
-  const std::size_t hyper = hyperelastic ? 4 * 4 * real + 1 : 0;  // Q rows and C (hyper_store), tissue id
-  return elements * (4 * 4 * real + real + 4 + hyper) + cells * 4;
-}
-
-std::size_t estimated_volume_device_bytes(std::size_t elements, std::size_t surface_elements, std::size_t triangles,
-                                          Precision precision) {
-  const std::size_t real = precision == Precision::Double ? 8 : 4;
-  const std::size_t groups = (surface_elements + kCheckWorkGroup - 1) / kCheckWorkGroup;  // one item per surface element
-  return triangles * 3 * 4                       // triangle corners (element ids)
-         + surface_elements * 4 + (surface_elements + 1) * 4 + triangles * 3 * 8  // CSR of incident corners (pairs)
-         + elements * 4 * real                   // gradient per element
-         + (groups * kVolumeSlots + kVolumeScalars) * real;
-}
 
 Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const ClContext& cl)
     : scene_(scene),
@@ -609,15 +502,6 @@ void Simulator::set_rest_offsets(const std::vector<double>& u0) {
   cl_.queue.finish();
 }
 
-void Simulator::make_contact_area_buffer() {
-  // Rest shares: contact happens on the surface, and a share changes little with the deformation.
-  const SurfaceMesh built = volume_ ? SurfaceMesh{} : build_surface(lattice_);
-  const SurfaceMesh& mesh = volume_ ? surface_ : built;
-  contact_area_host_ = element_surface_area_m2(mesh, element_positions_m(lattice_));
-  contact_area_ = make_real_buffer(contact_area_host_);
-  check_.setArg(kCheckVolume + (volume_ ? 2 : 0), contact_area_);
-}
-
 void Simulator::make_state_arena(std::size_t state_bytes, std::size_t frame_bytes) {
   // Everything the step's kernels read or write besides the model arena (kernels/common.cl,
   // VB_STATE_PARAM), zeros to start with but the obstacle table.
@@ -633,210 +517,9 @@ void Simulator::make_state_arena(std::size_t state_bytes, std::size_t frame_byte
       parts.insert(parts.end(), {{&vol_grad_pred_, grad}, {&vol_scalars_pred_, scalars}, {&vol_no_scalars_, scalars}});
   }
   for (const auto& [buffer, bytes] : parts) state_.add(buffer == &indenters_ ? table.data() : nullptr, bytes);
-  require(state_.bytes() <= cl_.info.max_allocation_bytes,
-          "the model's state needs one buffer of " + mib(double(state_.bytes())) + " but '" + cl_.info.name +
-              "' allocates at most " + mib(double(cl_.info.max_allocation_bytes)),
-          "model", "downsample or crop the model");
+  require_buffer_fits("the model's state", state_.bytes(), cl_.info);
   state_.create(cl_);
   for (std::size_t i = 0; i < parts.size(); ++i) *parts[i].first = state_.part(i);
-}
-
-void Simulator::make_volume_buffers(const SurfaceMesh& mesh, const std::vector<cl_uint>& surface,
-                                    const std::vector<std::uint32_t>& surface_index) {
-  // Triangles as element ids; per surface element the corners (3·triangle + corner) it is in,
-  // over all its vertices (an element on a pinch has several).
-  std::vector<cl_uint> triangles(3 * mesh.triangles.size()), start(surface.size() + 1, 0), incident;
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-    for (int c = 0; c < 3; ++c) {
-      triangles[3 * t + c] = mesh.element_of_vertex[mesh.triangles[t][c]];
-      ++start[surface_index[triangles[3 * t + c]] + 1];
-    }
-  for (std::size_t i = 0; i < surface.size(); ++i) start[i + 1] += start[i];
-  incident.resize(start.back());
-  std::vector<cl_uint> fill(start.begin(), start.end() - 1);
-  for (std::size_t k = 0; k < triangles.size(); ++k) incident[fill[surface_index[triangles[k]]]++] = cl_uint(k);
-  if (volume_pairs_) {  // per incident corner the triangle's other two corners' elements, in cyclic order
-    std::vector<cl_uint> pairs(2 * incident.size());
-    for (std::size_t k = 0; k < incident.size(); ++k) {
-      const std::size_t t = incident[k] / 3, corner = incident[k] % 3;
-      pairs[2 * k] = triangles[3 * t + (corner + 1) % 3];
-      pairs[2 * k + 1] = triangles[3 * t + (corner + 2) % 3];
-    }
-    incident = std::move(pairs);
-  }
-
-  frame_sign_ = lattice_.rotation.determinant() < 0 ? -1.0 : 1.0;
-  rest_volume_m3_ = double(mesh.complete_cell_count) * std::pow(lattice_.spacing_m, 3);
-  Vec3 centre = Vec3::Zero();  // positions are taken relative to it, to keep rounding small
-  for (const cl_uint e : surface) centre += lattice_.rest_position(e);
-  centre /= double(surface.size());
-  vol_centre_ = centre;
-
-  // one buffer for the mesh (device_arena.hpp), slots as kernels/volume.cl's VB_UNPACK_MESH
-  vol_mesh_.add(triangles.data(), triangles.size() * sizeof(cl_uint));
-  vol_mesh_.add(surface.data(), surface.size() * sizeof(cl_uint));
-  vol_mesh_.add(start.data(), start.size() * sizeof(cl_uint));
-  vol_mesh_.add(incident.data(), incident.size() * sizeof(cl_uint));
-  vol_mesh_.create(cl_);
-  for (int i = 0; i < 4; ++i) vol_mesh_at_.s[i] = vol_mesh_.offset_units(std::size_t(i));
-  // (the gradient, zero off the surface, the partial sums and the scalars are in the state arena)
-  const cl_uint zero = 0;  // volume_project's count of finished work-groups
-  vol_done_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof zero, const_cast<cl_uint*>(&zero));
-
-  // volume_partials and volume_project take the same lattice, mesh, centre and gradient arguments
-  // (volume_partials, a step kernel, the gradient as a state arena offset)
-  const auto mesh_kernel = [&](const char* name, bool state_offsets) {
-    cl::Kernel k(program_, name);
-    set_lattice_args(k, 2);
-    k.setArg(kVolumeMesh + 0, vol_mesh_.buffer());
-    k.setArg(kVolumeMesh + 1, vol_mesh_at_);
-    k.setArg(kVolumeMesh + 2, cl_uint(volume_surface_));
-    set_world_vector(k, kVolumeCentre, centre);
-    if (state_offsets) k.setArg(kVolumeCentre + 1, at(vol_grad_));
-    else k.setArg(kVolumeCentre + 1, vol_grad_);
-    return k;
-  };
-  vol_partials_ = mesh_kernel("volume_partials", true);
-  vol_partials_.setArg(kVolumeWithForce + 1, at(vol_partial_));
-  set_state_arena_arg(vol_partials_);
-  vol_finish_ = cl::Kernel(program_, "volume_finish");
-  vol_finish_.setArg(0, vol_partial_);
-  vol_finish_.setArg(1, cl_uint(volume_groups_));
-  vol_finish_.setArg(3, vol_scalars_);
-  vol_apply_ = cl::Kernel(program_, "volume_apply");
-  vol_apply_.setArg(2, vol_mesh_.buffer());
-  vol_apply_.setArg(3, vol_mesh_at_);
-  vol_apply_.setArg(4, cl_uint(volume_surface_));
-  vol_apply_.setArg(5, at(vol_grad_));
-  vol_apply_.setArg(6, at(vol_partial_));
-  vol_apply_.setArg(7, cl_uint(volume_groups_));
-  vol_apply_.setArg(kApplyRestVolume + 1, at(vol_scalars_));
-  set_state_arena_arg(vol_apply_);
-  vol_project_ = mesh_kernel("volume_project", false);
-  vol_project_.setArg(kProjectGrad + 1, vol_partial_);
-  vol_project_.setArg(kProjectRestVolume + 1, vol_scalars_);
-  vol_project_.setArg(kProjectRestVolume + 2, vol_done_);
-  if (volume_launches_ == 0) {
-    // the predicted stage's projection has its own gradient and scalars: the state's stays
-    // pending for heun_correct's own u, v while the stage's is computed
-    // (its gradient and scalars, and zero scalars, are in the state arena)
-    device_bytes_ += 4 * real_size_ * n_;
-    vol_pending_ = mesh_kernel("volume_pending", false);
-    vol_pending_.setArg(kProjectGrad + 1, vol_partial_);
-    vol_pending_.setArg(kProjectRestVolume + 2, vol_done_);
-    set_fold_args(false, false);
-  }
-  if (volume_lag_) {  // heun_predict's or relax_step's (and lanes') last arguments before VB_TRI_PARAMS, the arena
-    cl::Kernel& k = relax_ ? relax_kernel_ : predict_;
-    const int last = int(k.getInfo<CL_KERNEL_NUM_ARGS>()) - (tri_contact_ ? kTriangleArgs : 0) - 1;
-    k.setArg(last - 2, at(vol_grad_));
-    k.setArg(last - 1, at(vol_scalars_));
-  }
-  if (relax_) {  // the projection weights by relaxation's masses (kernels/volume.cl, VB_PROJECTION_PARAM)
-    const auto from_end = [&](cl::Kernel& k, cl_uint back) { k.setArg(k.getInfo<CL_KERNEL_NUM_ARGS>() - back, relax_scale_); };
-    from_end(vol_partials_, 2);  // before the state arena
-    from_end(vol_apply_, 2);
-    from_end(vol_project_, 1);
-  }
-  set_rest_volume_args();
-  check_.setArg(kCheckVolume, vol_grad_);
-  check_.setArg(kCheckVolume + 1, vol_scalars_);
-}
-
-void Simulator::set_rest_volume_args() {
-  const double v0 = frame_sign_ * rest_volume_m3_;  // lattice frame
-  set_real(vol_finish_, 2, v0);
-  set_real(vol_apply_, kApplyRestVolume, v0);
-  set_real(vol_project_, kProjectRestVolume, v0);
-  if (volume_launches_ == 0) set_real(vol_pending_, kProjectRestVolume, v0);
-  if (persistent_kernel_()) set_persistent_rest_volume(v0);
-}
-
-void Simulator::set_fold_args(bool state_pending, bool pred_pending) {
-  // kernels/integrate.cl (VB_FOLD_PARAMS): after dt, n the state's gradient and scalars, then
-  // (heun_correct) the predicted stage's; zero scalars where nothing is pending
-  // (state arena offsets)
-  const cl_uint state = at(state_pending ? vol_scalars_ : vol_no_scalars_);
-  const cl_uint pred = at(pred_pending ? vol_scalars_pred_ : vol_no_scalars_);
-  const int a = kStepIndenter + kIndenterArgs + 2;
-  for (cl::Kernel* k : {&predict_, &correct_}) {
-    k->setArg(a, at(vol_grad_));
-    k->setArg(a + 1, state);
-  }
-  correct_.setArg(a + 2, at(vol_grad_pred_));
-  correct_.setArg(a + 3, pred);
-}
-
-void Simulator::enqueue_pending_projection(const cl::Buffer& u, const cl::Buffer& v, bool predicted) {
-  vol_pending_.setArg(0, u);
-  vol_pending_.setArg(1, v);
-  vol_pending_.setArg(kProjectGrad, predicted ? vol_grad_pred_ : vol_grad_);
-  vol_pending_.setArg(kProjectRestVolume + 1, predicted ? vol_scalars_pred_ : vol_scalars_);
-  launch(vol_pending_, cl::NDRange(volume_groups_ * kCheckWorkGroup), cl::NDRange(kCheckWorkGroup));
-}
-
-void Simulator::apply_pending_projection() const {
-  if (!pending_) return;
-  // volume_apply sums the partials the last volume_pending left (the same λ, μ) and applies them
-  pending_ = false;
-  vol_apply_.setArg(0, at(u_));
-  vol_apply_.setArg(1, at(v_));
-  const std::size_t wg = kCheckWorkGroup, global = (volume_surface_ + wg - 1) / wg * wg;
-  launch(vol_apply_, cl::NDRange(global), cl::NDRange(wg));
-}
-
-void Simulator::enqueue_volume_sums(bool with_force) { enqueue_volume_sums(with_force, u_, v_); }
-
-void Simulator::enqueue_volume_partials(bool with_force, const cl::Buffer& u, const cl::Buffer& v) {
-  vol_partials_.setArg(0, at(u));
-  vol_partials_.setArg(1, at(v));
-  vol_partials_.setArg(kVolumeWithForce, cl_int(with_force));
-  launch(vol_partials_, cl::NDRange(volume_groups_ * kCheckWorkGroup), cl::NDRange(kCheckWorkGroup));
-}
-
-void Simulator::enqueue_volume_sums(bool with_force, const cl::Buffer& u, const cl::Buffer& v) {
-  enqueue_volume_partials(with_force, u, v);
-  launch(vol_finish_, cl::NDRange(kCheckWorkGroup), cl::NDRange(kCheckWorkGroup));
-}
-
-void Simulator::enqueue_volume_correction(const cl::Buffer& u, const cl::Buffer& v) {
-  if (volume_launches_ == 1) {  // sums, λ and μ, and the projection in one launch
-    vol_project_.setArg(0, u);
-    vol_project_.setArg(1, v);
-    const std::size_t groups = (volume_surface_ + volume_wg_ - 1) / volume_wg_;
-    launch(vol_project_, cl::NDRange(groups * volume_wg_), cl::NDRange(volume_wg_));
-    return;
-  }
-  enqueue_volume_partials(false, u, v);  // volume_apply sums the partials itself: no volume_finish
-  vol_apply_.setArg(0, at(u));
-  vol_apply_.setArg(1, at(v));
-  const std::size_t wg = kCheckWorkGroup, global = (volume_surface_ + wg - 1) / wg * wg;
-  launch(vol_apply_, cl::NDRange(global), cl::NDRange(wg));
-}
-
-double Simulator::enclosed_volume_m3() {
-  require(volume_, "the enclosed volume is computed on the device only with [volume] preserve = true");
-  apply_pending_projection();
-  enqueue_volume_sums(false);
-  return read_enclosed_volume_m3();
-}
-
-double Simulator::read_enclosed_volume_m3() const { return frame_sign_ * volume_scalars().volume_m3; }
-
-Simulator::VolumeScalars Simulator::volume_scalars() const {
-  require(volume_, "the volume constraint's scalars exist only with [volume] preserve = true");
-  const std::vector<double> s = read_reals(vol_scalars_, kVolumeScalars);  // λ, μ, V, p, M (kernels/volume.cl)
-  return {s[0], s[1], s[2], s[3], s[4]};
-}
-
-std::vector<double> Simulator::volume_gradient_m2() {
-  require(volume_, "the volume gradient is computed on the device only with [volume] preserve = true");
-  apply_pending_projection();
-  enqueue_volume_sums(false);
-  std::vector<double> g;
-  if (precision_ == Precision::Double) read_xyz<double>(vol_grad_, g); else read_xyz<float>(vol_grad_, g);
-  for (double& x : g) x *= frame_sign_;
-  return g;
 }
 
 void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_int>& grid,
@@ -880,10 +563,7 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
   step_list_n_ = step_list.size();
   const std::size_t step_list_slot = step_list_ ? arena_.add(step_list.data(), std::max<std::size_t>(1, step_list_n_) * sizeof(cl_uint)) : 0;
   device_bytes_ += step_list_n_ * sizeof(cl_uint);
-  require(arena_.bytes() <= cl_.info.max_allocation_bytes,
-          "the model's arrays need one buffer of " + mib(double(arena_.bytes())) + " but '" + cl_.info.name +
-              "' allocates at most " + mib(double(cl_.info.max_allocation_bytes)),
-          "model", "downsample or crop the model");
+  require_buffer_fits("the model's arrays", arena_.bytes(), cl_.info);
   arena_.create(cl_);
   for (int i = 0; i < 8; ++i) arena_at_.s[i] = arena_.offset_units(slot[i]);
   arena_at_pred_ = arena_at_;
@@ -955,115 +635,6 @@ void Simulator::set_lattice_args(cl::Kernel& k, int a) {
   set_real(k, a + 7, damping_);
   set_world_vector(k, a + 8, lattice_.origin_m);
   set_real(k, a + 9, scene_.solver.hourglass);
-}
-
-Vec3 Simulator::indenter_position(std::size_t i, double t) const {
-  const std::vector<PathKnot>& path = scene_.indenters.at(i).path;
-  if (path.empty()) return motion_.at(i).position_m(t);
-  if (t <= path.front().time_s) return path.front().position_m;
-  for (std::size_t k = 0; k + 1 < path.size(); ++k)
-    if (t < path[k + 1].time_s) {
-      const double f = (t - path[k].time_s) / (path[k + 1].time_s - path[k].time_s);
-      return path[k].position_m + f * (path[k + 1].position_m - path[k].position_m);
-    }
-  return path.back().position_m;
-}
-
-std::vector<double> Simulator::indenter_row(std::size_t i) const {
-  const IndenterSpec& ind = scene_.indenters[i];
-  const IndenterMotion& m = motion_[i];
-  const Eigen::Matrix3d Rt = lattice_.rotation.transpose();
-  std::vector<double> row(kIndenterStride, 0.0);
-  const Vec3 start = Rt * m.start_m, normal = Rt * ind.normal, velocity = Rt * m.velocity_m_s;
-  for (int c = 0; c < 3; ++c) row[c] = start[c], row[4 + c] = normal[c], row[8 + c] = velocity[c];
-  row[3] = ind.kind == IndenterSpec::Kind::Plate ? -1.0 : ind.radius_m;
-  row[12] = std::isfinite(m.travel_time_s) ? m.travel_time_s : 1e300;
-  row[13] = double(int(ind.contact));  // 0 push, 1 slide, 2 stick
-  row[14] = double(int(ind.kind));     // 0 sphere, 1 plate, 2 cylinder, 3 capsule
-  row[15] = ind.length_m;
-  row[16] = m.t0_s;
-  row[17] = ind.friction;  // Coulomb μ (push contact)
-  row[18] = ind.contact_surface == IndenterSpec::Surface::Triangles ? 1.0 : 0.0;
-  row[19] = contact_stiffness_n_m_.at(i);  // the penalty of triangle contact (N/m)
-  return row;
-}
-
-void Simulator::set_indenter_motion(std::size_t i, const IndenterMotion& motion) {
-  require(i < scene_.indenters.size(), "no indenter " + std::to_string(i) + " in the scene", "indenter");
-  motion_[i] = motion;
-  const std::vector<double> row = indenter_row(i);
-  const std::size_t offset = kIndenterStride * i * real_size_;
-  if (precision_ == Precision::Double) {
-    cl_.queue.enqueueWriteBuffer(indenters_, CL_TRUE, offset, row.size() * sizeof(double), row.data());
-  } else {
-    std::vector<float> f(row.size());
-    for (std::size_t k = 0; k < row.size(); ++k) f[k] = float(std::clamp(row[k], -3e38, 3e38));
-    cl_.queue.enqueueWriteBuffer(indenters_, CL_TRUE, offset, f.size() * sizeof(float), f.data());
-  }
-}
-
-void Simulator::follow_paths(double t) {
-  for (std::size_t i = 0; i < scene_.indenters.size(); ++i) {
-    const std::vector<PathKnot>& path = scene_.indenters[i].path;
-    if (path.size() < 2) continue;
-    std::size_t k = 0;  // the last segment starting at or before t (the first before the path starts)
-    while (k + 2 < path.size() && path[k + 1].time_s <= t) ++k;
-    if (k == path_segment_[i]) continue;
-    path_segment_[i] = k;
-    const double span = path[k + 1].time_s - path[k].time_s;
-    set_indenter_motion(i, {path[k].position_m, (path[k + 1].position_m - path[k].position_m) / span,
-                            path[k].time_s, span});
-  }
-}
-
-std::size_t Simulator::torus_table_base() const {
-  return kIndenterStride * std::max<std::size_t>(1, scene_.indenters.size());
-}
-
-std::vector<double> Simulator::obstacle_table() const {
-  // Rows in the lattice frame (kernels/common.cl, VB_INDENTER_PARAMS); a placeholder row if none.
-  std::vector<double> table(torus_table_base(), 0.0);
-  const Eigen::Matrix3d Rt = lattice_.rotation.transpose();
-  for (std::size_t i = 0; i < scene_.indenters.size(); ++i) {
-    const std::vector<double> row = indenter_row(i);
-    std::copy(row.begin(), row.end(), table.begin() + kIndenterStride * i);
-  }
-  // Torus rows (kernels/device_contact.cl), then each torus's knots: time, minor and major
-  // radius, and for the segment to the next knot 1/span and the two rates (0 for the last).
-  const std::size_t knots_base = table.size() + kTorusStride * scene_.tori.size();
-  table.resize(knots_base, 0.0);
-  for (std::size_t i = 0; i < scene_.tori.size(); ++i) {
-    const TorusSpec& t = scene_.tori[i];
-    double* row = &table[torus_table_base() + kTorusStride * i];
-    const Vec3 centre = Rt * t.center_m, axis = Rt * t.axis, perpendicular = Rt * reference_perpendicular(t.axis);
-    for (int c = 0; c < 3; ++c) row[c] = centre[c], row[4 + c] = axis[c], row[8 + c] = perpendicular[c];
-    row[3] = t.friction;
-    row[7] = double(t.schedule.size());
-    row[11] = double(table.size());
-    for (std::size_t j = 0; j < t.schedule.size(); ++j) {
-      const TorusKnot& k = t.schedule[j];
-      double inverse_span = 0, minor_rate = 0, major_rate = 0;
-      if (j + 1 < t.schedule.size()) {
-        const TorusKnot& next = t.schedule[j + 1];
-        inverse_span = 1 / (next.time_s - k.time_s);
-        minor_rate = (next.minor_radius_m - k.minor_radius_m) * inverse_span;
-        major_rate = (next.major_radius_m - k.major_radius_m) * inverse_span;
-      }
-      table.insert(table.end(), {k.time_s, k.minor_radius_m, k.major_radius_m, inverse_span, minor_rate, major_rate});
-    }
-  }
-  require(table.size() < (1u << 24), "the device's inflation schedules are too long", "device.torus");  // exact in float
-  return table;
-}
-
-void Simulator::set_indenter_args(cl::Kernel& k, int a, double t_force, double t_project) {
-  k.setArg(a, indenters_);
-  set_indenter_times(k, a, t_force, t_project);
-}
-
-void Simulator::set_indenter_times(cl::Kernel& k, int a, double t_force, double t_project) {
-  set_real(k, a + 1, t_force);
-  set_real(k, a + 2, t_project);
 }
 
 void Simulator::set_state_arena_arg(cl::Kernel& k) const {
@@ -1266,168 +837,10 @@ void Simulator::set_gravity(const Vec3& g) {
   }
 }
 
-std::vector<double> Simulator::read_reals(const cl::Buffer& buffer, std::size_t count) const {
-  std::vector<double> out(count);
-  if (precision_ == Precision::Double) {
-    cl_.queue.enqueueReadBuffer(buffer, CL_TRUE, 0, count * sizeof(double), out.data());
-  } else {
-    std::vector<float> f(count);
-    cl_.queue.enqueueReadBuffer(buffer, CL_TRUE, 0, count * sizeof(float), f.data());
-    std::copy(f.begin(), f.end(), out.begin());
-  }
-  return out;
-}
-
-template <typename T>
-void Simulator::read_xyz(const cl::Buffer& buffer, std::vector<double>& world) const {
-  std::vector<T> data(4 * n_);
-  cl_.queue.enqueueReadBuffer(buffer, CL_TRUE, 0, data.size() * sizeof(T), data.data());
-  unpack4(data, world);
-  for (std::size_t e = 0; e < n_; ++e) {
-    const Vec3 w = lattice_.rotation * Vec3(world[3 * e], world[3 * e + 1], world[3 * e + 2]);
-    for (int c = 0; c < 3; ++c) world[3 * e + c] = w[c];
-  }
-}
-
-template <typename T>
-void Simulator::write_xyz(const cl::Buffer& buffer, const std::vector<double>& world, const std::vector<double>* w) const {
-  auto data = pack4<T>(to_lattice_frame(world), w);
-  cl_.queue.enqueueWriteBuffer(buffer, CL_TRUE, 0, data.size() * sizeof(T), data.data());
-}
-
-std::vector<double> Simulator::to_lattice_frame(const std::vector<double>& world) const {
-  std::vector<double> out(world.size());
-  const Eigen::Matrix3d Rt = lattice_.rotation.transpose();
-  for (std::size_t e = 0; e < world.size() / 3; ++e) {
-    const Vec3 x = Rt * Vec3(world[3 * e], world[3 * e + 1], world[3 * e + 2]);
-    for (int c = 0; c < 3; ++c) out[3 * e + c] = x[c];
-  }
-  return out;
-}
-
-void Simulator::download(std::vector<double>& u, std::vector<double>& v) const {
-  check_grid_barriers();  // a state the persistent step left invalid is never handed out
-  apply_pending_projection();
-  if (precision_ == Precision::Double) {
-    read_xyz<double>(u_, u);
-    read_xyz<double>(v_, v);
-  } else {
-    read_xyz<float>(u_, u);
-    read_xyz<float>(v_, v);
-  }
-}
-
-void Simulator::upload(const std::vector<double>& u, const std::vector<double>& v) {
-  require(u.size() == 3 * n_ && v.size() == 3 * n_, "state size does not match the model");
-  pending_ = false;  // the new state replaces the one the projection was for
-  // nor is the lagged multiplier that of the new state: start it at zero (all-zero bytes; the
-  // constructor's upload comes before the buffer, which starts at zero)
-  if (volume_lag_ && vol_scalars_())
-    cl_.queue.enqueueFillBuffer(vol_scalars_, cl_uchar(0), std::size_t(kVolumeScalars - 1) * real_size_, real_size_);
-  if (precision_ == Precision::Double) {
-    write_xyz<double>(u_, u, &inverse_mass_);
-    write_xyz<double>(v_, v, nullptr);
-  } else {
-    write_xyz<float>(u_, u, &inverse_mass_);
-    write_xyz<float>(v_, v, nullptr);
-  }
-  if (lanes_ || step_list_) mirror_state();
-  if (relax_) {
-    held_u_.clear();
-    for (std::size_t e = 0; e < n_; ++e)
-      if (inverse_mass_[e] == 0) held_u_.insert(held_u_.end(), {u[3 * e], u[3 * e + 1], u[3 * e + 2]});
-    update_relax_from_rest();
-    relax_prev_valid_ = false;  // relax_prev_ holds a state before this one, of another run
-  }
-}
-
 void Simulator::update_relax_from_rest() {
   relax_from_rest_valid_ = true;
   for (std::size_t i = 0; i < held_u_.size(); ++i)
     if (std::abs(held_u_[i] - (held_u0_.empty() ? 0.0 : held_u0_[i])) > 1e-9) relax_from_rest_valid_ = false;
-}
-
-void Simulator::mirror_state() {
-  cl_.queue.enqueueCopyBuffer(u_, u_tmp_, 0, 0, 4 * real_size_ * n_);
-  cl_.queue.enqueueCopyBuffer(v_, v_tmp_, 0, 0, 4 * real_size_ * n_);
-}
-
-std::vector<double> Simulator::lattice_forces() {
-  cl::Kernel k(program_, "lattice_forces");
-  cl::Buffer f(cl_.context, CL_MEM_WRITE_ONLY, 4 * real_size_ * n_);
-  k.setArg(0, u_);
-  k.setArg(1, v_);
-  set_lattice_args(k, 2);
-  k.setArg(2 + kLatticeArgs, f);
-  k.setArg(3 + kLatticeArgs, cl_uint(n_));
-  apply_pending_projection();
-  enqueue_stress(u_);
-  enqueue(k);
-  std::vector<double> out;
-  if (precision_ == Precision::Double) read_xyz<double>(f, out); else read_xyz<float>(f, out);
-  return out;
-}
-
-}  // namespace vb
-
-namespace vb {
-
-void Simulator::make_triangle_contact_buffers() {
-  const TriangleContactMesh m = triangle_contact_mesh(surface_, n_);
-  const auto flags_ro = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
-  const auto buffer = [&](auto& v) {
-    return cl::Buffer(cl_.context, flags_ro, v.size() * sizeof(v[0]), const_cast<void*>(static_cast<const void*>(v.data())));
-  };
-  tri_elements_ = buffer(m.triangles);
-  tri_start_ = buffer(m.start);
-  tri_corner_ = buffer(m.corner);
-  const std::size_t corners = 3 * tri_triangles_ * std::max<std::size_t>(1, scene_.indenters.size());
-  std::vector<char> zeros(corners * 4 * real_size_, 0);
-  corner_force_ = cl::Buffer(cl_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, zeros.size(), zeros.data());
-
-  // kernels/triangle_contact.cl: u, cell_of, sy, sz, origin, h, triangles, count, frame sign,
-  // indenters, t, corner forces
-  tri_kernel_ = cl::Kernel(program_, "triangle_contact");
-  tri_kernel_.setArg(1, cell_);
-  tri_kernel_.setArg(2, cl_int(stride_y_));
-  tri_kernel_.setArg(3, cl_int(stride_z_));
-  set_world_vector(tri_kernel_, 4, lattice_.origin_m);
-  set_real(tri_kernel_, 5, lattice_.spacing_m);
-  tri_kernel_.setArg(6, tri_elements_);
-  tri_kernel_.setArg(7, cl_uint(tri_triangles_));
-  set_real(tri_kernel_, 8, lattice_.rotation.determinant() < 0 ? -1.0 : 1.0);  // outward in the lattice frame
-  tri_kernel_.setArg(9, indenters_);
-  tri_kernel_.setArg(11, corner_force_);
-  for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_, &check_}) {
-    if (!(*k)()) continue;
-    // VB_TRI_PARAMS, last but for the stepping kernels' state arena
-    const int first = int(k->getInfo<CL_KERNEL_NUM_ARGS>()) - kTriangleArgs - (k == &check_ ? 0 : 1);
-    k->setArg(first + 0, corner_force_);
-    k->setArg(first + 1, tri_start_);
-    k->setArg(first + 2, tri_corner_);
-    k->setArg(first + 3, cl_uint(tri_triangles_));
-  }
-}
-
-void Simulator::enqueue_triangle_contact(const cl::Buffer& u, double t_s) {
-  if (!tri_contact_) return;
-  tri_kernel_.setArg(0, u);
-  set_real(tri_kernel_, 10, t_s);
-  const std::size_t wg = kCheckWorkGroup;
-  launch(tri_kernel_, cl::NDRange((tri_triangles_ + wg - 1) / wg * wg), cl_.info.is_gpu ? cl::NDRange(wg) : cl::NullRange);
-}
-
-std::vector<double> Simulator::triangle_contact_forces_n() {
-  require(tri_contact_, "no indenter of the scene uses contact_surface = \"triangles\"", "indenter");
-  enqueue_triangle_contact(u_, time_s());
-  const std::size_t count = 4 * 3 * tri_triangles_ * std::max<std::size_t>(1, scene_.indenters.size());
-  const std::vector<double> raw = read_reals(corner_force_, count);
-  std::vector<double> out(3 * (count / 4));
-  for (std::size_t k = 0; k < count / 4; ++k) {
-    const Vec3 w = lattice_.rotation * Vec3(raw[4 * k], raw[4 * k + 1], raw[4 * k + 2]);
-    for (int c = 0; c < 3; ++c) out[3 * k + c] = w[c];
-  }
-  return out;
 }
 
 }  // namespace vb

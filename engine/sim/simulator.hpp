@@ -13,6 +13,7 @@
 #include "engine/lattice/lattice.hpp"
 #include "engine/scene/scene.hpp"
 #include "engine/sim/device_arena.hpp"
+#include "engine/sim/device_memory.hpp"
 #include "engine/sim/element_setup.hpp"
 #include "engine/sim/opencl_runtime.hpp"
 #include "engine/sim/persistent_step.hpp"
@@ -64,19 +65,6 @@ struct StateCheck {
   double enclosed_volume_m3 = 0;
 };
 
-/// Device bytes a model of `elements` elements in a padded grid of `cells` voxels needs
-/// (hyperelastic models also store Q and C = FᵀF per element).
-std::size_t estimated_device_bytes(std::size_t elements, std::size_t cells, Precision precision,
-                                   bool hyperelastic = false);
-/// Refuses (vb::Error naming the model, its need, the device and a downsample factor that would
-/// fit) a model too large for `device` from its lattice alone, before the per-element arrays are
-/// built: in the time the lattice takes, not the minutes and host memory the arrays would (the
-/// Simulator checks again with every buffer counted).
-void check_lattice_fits_device(const Scene& scene, const Lattice& lattice, const DeviceInfo& device);
-/// Extra device bytes of the volume constraint (kernels/volume.cl): triangles, the per-surface-
-/// element CSR of incident triangle corners, the gradient (per element) and the partial sums.
-std::size_t estimated_volume_device_bytes(std::size_t elements, std::size_t surface_elements,
-                                          std::size_t triangles, Precision precision);
 
 /// Device time per kernel while profiling (ClContext with profiling on): launches and seconds.
 struct KernelProfile {
