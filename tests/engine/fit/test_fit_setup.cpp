@@ -55,6 +55,27 @@ TEST(FitFile, StrictErrorsNameTheKey) {
   EXPECT_NE(error_of(kObservation + "from_posture = \"sideways\"\n").find("fit.from_posture"), std::string::npos);
 }
 
+// The [fit] table is read by the scene file's own typed access (io/toml_section.hpp), so its
+// values meet the same rules as the rest of the scene: counts are integers, numbers finite.
+TEST(FitFile, ImpossibleValuesAreRefusedWithTheirKey) {
+  EXPECT_NE(error_of(kObservation + "max_iterations = 2.5\n").find("fit.max_iterations"), std::string::npos);
+  EXPECT_NE(error_of(kObservation + "max_steps = 1e30\n").find("fit.max_steps"), std::string::npos);
+  EXPECT_NE(error_of(kObservation + "max_steps = 0\n").find("fit.max_steps"), std::string::npos);
+  EXPECT_NE(error_of(kObservation + "max_E = inf\n").find("fit.max_E"), std::string::npos);
+  EXPECT_NE(error_of(kObservation + "tolerance = nan\n").find("fit.tolerance"), std::string::npos);
+  EXPECT_NE(error_of(kObservation + "from_gravity = [0, nan, 0]\n").find("fit.from_gravity"), std::string::npos);
+  EXPECT_NE(error_of(kObservation + "sigma_mm = -1\n").find("fit.sigma_mm"), std::string::npos);
+  EXPECT_NE(error_of(kObservation + "method = \"gauss_newton\"\n").find("gauss-newton"), std::string::npos);  // the hint
+  const FitSpec f = parse_fit_section(kObservation + "max_iterations = 7\nmax_steps = 90000\nmethod = \"bisection\"\n"
+                                      "regions = \"blocks\"\nblock_mm = 12\ninitial = \"materials\"\n", "s.toml");
+  EXPECT_EQ(f.max_iterations, 7);
+  EXPECT_EQ(f.max_steps, 90000);
+  EXPECT_EQ(f.method, FitSpec::Method::Bisection);
+  EXPECT_EQ(f.regions, FitSpec::Regions::Blocks);
+  EXPECT_DOUBLE_EQ(f.block_m, 0.012);
+  EXPECT_EQ(f.initial, FitSpec::Initial::Materials);
+}
+
 TEST(FitFile, BatchIsAutoOrACount) {
   EXPECT_EQ(parse_fit_section(kObservation, "s.toml").batch, 0);  // auto
   EXPECT_EQ(parse_fit_section(kObservation + "batch = \"auto\"\n", "s.toml").batch, 0);
