@@ -177,7 +177,6 @@ std::unique_ptr<DcmFileFormat> load_slice(const std::string& path, int rows, int
   return file;
 }
 
-
 namespace {
 
 /// Brings encapsulated (compressed) pixel data to native form with the registered decoders;

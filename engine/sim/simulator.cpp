@@ -28,13 +28,6 @@ std::vector<cl_uint> free_elements(const std::vector<double>& inverse_mass) {
   return list;
 }
 
-
-
-
-}  // namespace
-
-namespace {
-
 /// The elements of a surface mesh's vertices, each once in order of first appearance, and each
 /// element's place in that list (index_of; kNoSurface off the surface).
 constexpr std::uint32_t kNoSurface = 0xffffffffu;
@@ -59,9 +52,7 @@ std::vector<cl_uint> elements_read_by_free(const Lattice& lattice, const std::ve
   return list;
 }
 
-
 }  // namespace
-
 
 Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const ClContext& cl)
     : scene_(scene),
