@@ -5,7 +5,6 @@
 
 #include "engine/error.hpp"
 #include "engine/loads/posture.hpp"
-#include "io/did_you_mean.hpp"
 #include "io/toml_section.hpp"
 #include "io/toml_text.hpp"
 
@@ -19,8 +18,8 @@ const Keys kKeys = {
     "tolerance", "equilibrium", "max_steps", "batch", "observed_labels", "observed_label_values",
     "observed_surface", "observed_surface_values", "unloaded_reference"};
 
-/// The observed label values: a non-empty array of integers in [min, 65535].
-std::optional<std::vector<int>> label_values(const Section& t, std::string_view key, int min) {
+/// Observed label values: a non-empty array of integers in [0, 65535] (0: the body outline).
+std::optional<std::vector<int>> label_values(const Section& t, std::string_view key) {
   const toml::node* n = t.find(key);
   if (!n) return std::nullopt;
   const toml::array* a = n->as_array();
@@ -30,7 +29,7 @@ std::optional<std::vector<int>> label_values(const Section& t, std::string_view 
   std::vector<int> out;
   for (const toml::node& x : *a) {
     const std::int64_t v = x.as_integer()->get();
-    if (v < min || v > 65535) t.fail(key, "values must lie in [" + std::to_string(min) + ", 65535]");
+    if (v < 0 || v > 65535) t.fail(key, "values must lie in [0, 65535]");
     out.push_back(int(v));
   }
   return out;
@@ -83,7 +82,7 @@ FitSpec parse_fit_section(const std::string& scene_text, const std::string& scen
   if (kinds > 1)
     t.fail(f.observed_surface_paths.empty() ? "observed_labels" : "observed_surface",
            "give one kind of observation: displacements ('dvf', 'landmarks'), 'observed_labels' or 'observed_surface'");
-  if (const auto v = label_values(t, "observed_surface_values", 0)) {
+  if (const auto v = label_values(t, "observed_surface_values")) {
     if (f.observed_surface_paths.empty()) t.fail("observed_surface_values", "applies only with 'observed_surface'");
     f.observed_surface_values = *v;
   } else if (f.observed_surface_paths.size() == 1) {
@@ -92,7 +91,7 @@ FitSpec parse_fit_section(const std::string& scene_text, const std::string& scen
   if (f.observed_surface_values.size() != f.observed_surface_paths.size())
     t.fail("observed_surface_values", "give one value per surface in 'observed_surface' (0: the body outline, "
                                       "v: the boundary of the region of label v)");
-  if (const auto v = label_values(t, "observed_label_values", 0)) {
+  if (const auto v = label_values(t, "observed_label_values")) {
     if (f.observed_labels_path.empty()) t.fail("observed_label_values", "applies only with 'observed_labels'");
     f.observed_label_values = *v;
   }

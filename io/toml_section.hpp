@@ -47,7 +47,7 @@ bool contains(const Keys& words, std::string_view word);
 std::string joined(const Keys& words);
 /// Hint for a value outside a fixed set: a close match if there is one, and the whole set.
 std::string choice_hint(std::string_view word, const Keys& accepted);
-/// A number as a user wrote it (shortest form: 0.001, 1e+30).
+/// A number for a message, as a stream prints it (6 significant digits: 0.001, 1e+30).
 std::string format_number(double v);
 /// "scene.toml:12 key 'materials.adipose.E'" (the line left out when unknown).
 std::string where_string(const std::string& source, int line, const std::string& key_path);

@@ -4,15 +4,17 @@
 #include <string>
 
 #include "engine/error.hpp"
+#include "engine/sim/kernel_arg_layout.hpp"
 #include "engine/sim/persistent_step.hpp"
 #include "engine/sim/simulator.hpp"
 
 namespace vb {
 namespace {
 
-// heun_step_persistent's arguments (kernels/persistent.cl): u, v, ũ, ṽ, the lattice (10), the
-// obstacles, t0, t1, dt, n, rest frames; with the volume constraint 10 more; then sync, target.
-constexpr int kLattice = 4, kIndenters = kLattice + 10, kDt = kIndenters + 3, kRestFrame = kDt + 2;
+// heun_step_persistent's arguments (kernels/persistent.cl): u, v, ũ, ṽ, the lattice, the
+// obstacles, t0, t1, dt, n, rest frames (the stepping kernels' layout, kernel_arg_layout.hpp, up to
+// dt); with the volume constraint 10 more; then sync, target.
+constexpr int kLattice = kStepLattice, kIndenters = kStepIndenter, kDt = kIndenters + kIndenterArgs, kRestFrame = kDt + 2;
 constexpr int kMesh = kRestFrame + 1, kRestVolume = kMesh + 7, kProject = kMesh + 9;
 constexpr int kSyncWords = 2 + 12;  // count, fault flag, VB_PERSISTENT_TRACE's stamps (≤ 9 barriers + 2)
 /// the sync buffer's argument; the launch's first barrier target follows it
