@@ -5,6 +5,7 @@
 
 #include "engine/image/image_lattice.hpp"
 #include "engine/lattice/voxelise.hpp"
+#include "engine/sim/device_memory.hpp"
 #include "engine/sim/simulator.hpp"
 #include "io/dicom_io.hpp"
 #include "io/nifti_io.hpp"

@@ -68,8 +68,8 @@ FitSpec parse_fit_section(const std::string& scene_text, const std::string& scen
   f.mask_path = resolved(t.text("mask").value_or(""), scene_path);
   f.sigma_path = resolved(t.text("sigma").value_or(""), scene_path);
   f.observed_labels_path = resolved(t.text("observed_labels").value_or(""), scene_path);
-  if (table->get("observed_surface")) {  // one STL, or several (one per boundary)
-    if (const auto one = table->get("observed_surface")->as_string()) f.observed_surface_paths = {one->get()};
+  if (const toml::node* surface = t.find("observed_surface")) {  // one STL, or several (one per boundary)
+    if (const auto one = surface->as_string()) f.observed_surface_paths = {one->get()};
     else f.observed_surface_paths = t.strings("observed_surface").value_or(std::vector<std::string>{});
     if (f.observed_surface_paths.empty()) t.fail("observed_surface", "expected an STL file or an array of them");
     for (std::string& p : f.observed_surface_paths) p = resolved(p, scene_path);
@@ -121,7 +121,7 @@ FitSpec parse_fit_section(const std::string& scene_text, const std::string& scen
   f.tolerance = t.non_negative("tolerance").value_or(f.tolerance);
   f.equilibrium = t.positive("equilibrium").value_or(f.equilibrium);
   f.max_steps = t.integer<std::int64_t>("max_steps", 1).value_or(f.max_steps);
-  if (const toml::node* n = table->get("batch")) {
+  if (const toml::node* n = t.find("batch")) {
     if (n->is_string() && n->as_string()->get() == "auto") f.batch = 0;
     else if (!n->is_integer() || n->as_integer()->get() < 0 || n->as_integer()->get() > 256)
       t.fail("batch", "expected \"auto\" or an integer from 0 (auto) to 256", "batch = 1 solves one copy at a time");

@@ -13,7 +13,6 @@
 #include "engine/lattice/lattice.hpp"
 #include "engine/scene/scene.hpp"
 #include "engine/sim/device_arena.hpp"
-#include "engine/sim/device_memory.hpp"
 #include "engine/sim/element_setup.hpp"
 #include "engine/sim/opencl_runtime.hpp"
 #include "engine/sim/persistent_step.hpp"

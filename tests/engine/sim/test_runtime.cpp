@@ -5,6 +5,7 @@
 
 #include "engine/error.hpp"
 #include "engine/sim/device_arena.hpp"
+#include "engine/sim/device_memory.hpp"
 #include "engine/sim/opencl_runtime.hpp"
 #include "engine/sim/simulator.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
