@@ -4,15 +4,12 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <limits>
 #include <optional>
-#include <sstream>
 #include <string_view>
 #include <utility>
 #include <vector>
