@@ -15,6 +15,7 @@
 // over every element of every copy, so each copy is at least as converged as when solved alone.
 #include <algorithm>
 #include <chrono>
+#include <memory>
 
 #include "engine/error.hpp"
 #include "engine/fit/forward_model.hpp"
@@ -113,12 +114,18 @@ std::vector<ForwardSolution> ForwardModel::solve_batch(const std::vector<std::ve
                 std::min(scales.size_m, s.size_m)};
     }
     const bool own_rows = parts.front().hyperelastic;  // per-copy μ, κ rows; springs read E per element
-    const Lattice tiled = tile_lattice(lat, int(K), own_rows ? int(lat.tissue_names.size()) : 0);
     const ElementArrays el = concatenate(parts, own_rows);
     parts.clear();
-    Simulator sim(scene_, tiled, el, cl_);
+    BatchSimulator& kept = batch_sims_[K];
+    if (!kept.sim) {
+      kept.lattice = std::make_unique<Lattice>(tile_lattice(lat, int(K), own_rows ? int(lat.tissue_names.size()) : 0));
+      kept.sim = std::make_unique<Simulator>(scene_, *kept.lattice, el, cl_);
+      ++timing_.simulators;
+    } else {
+      kept.sim->set_materials(el);  // as a simulator built with el starts
+    }
+    Simulator& sim = *kept.sim;
     solves_ += K;
-    ++timing_.simulators;
     const std::vector<double> zeros(3 * n * K, 0.0);
     lap(&JacobianTiming::setup_s);
     std::vector<double> from(3 * n * K, 0.0), to, v;

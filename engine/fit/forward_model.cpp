@@ -74,6 +74,8 @@ ForwardModel::ForwardModel(const Scene& scene, const Lattice& lattice, const Fit
   }
 }
 
+ForwardModel::~ForwardModel() = default;
+
 ElementArrays ForwardModel::arrays(const std::vector<double>& E) const {
   require(E.size() == regions_.size(), "one modulus per region expected", "fit");
   if (split_) {
@@ -127,7 +129,10 @@ ForwardSolution ForwardModel::solve_timed(const std::vector<double>& E, const Fo
     lap(&JacobianTiming::relax_s);
     return out;
   }
-  Simulator sim(scene_, lat, el, cl_);
+  const bool build = !sim_;
+  if (build) sim_ = std::make_unique<Simulator>(scene_, lat, el, cl_);
+  else sim_->set_materials(el);  // as a simulator built with el starts
+  Simulator& sim = *sim_;
   const std::size_t n = lat.element_count();
   const std::vector<double> zeros(3 * n, 0.0);
   const EquilibriumScales scales = equilibrium_scales(lat, el);
@@ -151,7 +156,7 @@ ForwardSolution ForwardModel::solve_timed(const std::vector<double>& E, const Fo
   sim.download(out.to_m, v);
   lap(&JacobianTiming::readback_s);
   if (timing) {
-    ++timing->simulators;
+    timing->simulators += build;
     timing->steps += out.steps;
     timing->element_steps += double(out.steps) * double(n);
     timing->most_column_steps = std::max(timing->most_column_steps, out.steps);

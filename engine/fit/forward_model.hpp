@@ -2,6 +2,8 @@
 /// The forward model of a fit: region moduli → the displacement of the posture change, solved to
 /// static equilibrium with dynamic relaxation (docs/FIT.md, "Forward model").
 #include <cstdint>
+#include <map>
+#include <memory>
 #include <vector>
 
 #include "engine/fit/fit_regions.hpp"
@@ -9,6 +11,8 @@
 #include "engine/sim/opencl_runtime.hpp"
 
 namespace vb {
+
+class Simulator;
 
 struct ForwardSolution {
   std::vector<double> from_m;  ///< n×3 equilibrium displacement in the `from` posture (m, world); zeros without one
@@ -28,8 +32,10 @@ struct ForwardSolution {
 struct JacobianTiming {
   std::size_t jacobians = 0;   ///< solve_batch calls
   std::size_t columns = 0;     ///< perturbed solves
-  std::size_t simulators = 0;  ///< simulators built for them (one per batch, or per solve)
-  double setup_s = 0;    ///< element arrays, tiling and Simulator construction (buffers, kernels, model upload)
+  std::size_t simulators = 0;  ///< simulators built for them: each is built once and kept (ForwardModel::solve)
+  /// element arrays, tiling and Simulator construction (buffers, kernels, model upload), or the
+  /// kept simulator's new moduli
+  double setup_s = 0;
   double upload_s = 0;   ///< warm-start state uploads
   double relax_s = 0;    ///< relaxation steps with their convergence checks (both postures)
   double readback_s = 0; ///< the solutions' downloads
@@ -46,16 +52,22 @@ class ForwardModel {
   /// vb::Error without [gravity] or for more than 255 (tissue, region) pairs.
   ForwardModel(const Scene& scene, const Lattice& lattice, const FitRegions& regions, const FitSpec& fit,
                const ClContext& cl);
+  ~ForwardModel();
+  ForwardModel(const ForwardModel&) = delete;  // its simulator refers to its scene and lattice
+  ForwardModel& operator=(const ForwardModel&) = delete;
 
   /// Solves both postures with these region moduli (Pa). `warm`: start from its states (fewer
   /// steps when the moduli changed little). Throws vb::Error when a posture does not reach
-  /// equilibrium in fit.max_steps.
+  /// equilibrium in fit.max_steps. One simulator serves every solve: built by the first, given
+  /// each later solve's moduli (Simulator::set_materials), so a solve equals one on a simulator
+  /// built for it (the unloaded reference state builds its own, reference_forward.hpp).
   ForwardSolution solve(const std::vector<double>& region_modulus_pa, const ForwardSolution* warm = nullptr) const;
 
   /// Solves several sets of region moduli (each as solve(moduli[k], warm)) with the copies of the
   /// model side by side in one simulator, batch_size() copies at a time (docs/FIT.md, "Batched
   /// solves"; engine/fit/forward_batch.cpp). Each result equals its solve() to the equilibrium
-  /// tolerance; every copy reports the batch's steps.
+  /// tolerance; every copy reports the batch's steps. A batch of K copies reuses the simulator of
+  /// the last batch of K (new moduli only), as solve() does.
   std::vector<ForwardSolution> solve_batch(const std::vector<std::vector<double>>& moduli,
                                            const ForwardSolution* warm = nullptr) const;
   /// Copies per simulator: fit.batch = N (at most the 256 tissue ids allow), or 1 for auto (0) on
@@ -100,6 +112,14 @@ class ForwardModel {
   mutable double batch_wall_s_ = 0;
   mutable JacobianTiming timing_;
   mutable std::size_t reference_solves_ = 0;
+  mutable std::unique_ptr<Simulator> sim_;  ///< solve()'s, built by the first solve
+  /// solve_batch's simulators by copies per batch (a Jacobian's full batches and its remainder),
+  /// each with the tiled lattice it refers to; built by the first batch of that size
+  struct BatchSimulator {
+    std::unique_ptr<Lattice> lattice;
+    std::unique_ptr<Simulator> sim;
+  };
+  mutable std::map<std::size_t, BatchSimulator> batch_sims_;
 };
 
 }  // namespace vb

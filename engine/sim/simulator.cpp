@@ -116,6 +116,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   contact_stiffness_n_m_ = penalty.stiffness_n_m;
   rest_offsets_ = scene.reference_state.active;
   hyper_ = el.hyperelastic;
+  biphasic_ = el.biphasic;
   plan_launches(scene, el, cl);
   if (stress_pair_) device_bytes_ += n_ * 4 * 4 * real_size_;  // the predicted stage's Q rows and C
   require_fits_device(device_bytes_, n_, cells, el.hyperelastic, scene, cl.info);
@@ -270,8 +271,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
       k.setArg(7, at(rest_frame_));
       set_state_arena_arg(k);
       if (stress_pair_) {
-        k.setArg(8, at(v_));
-        set_real(k, 9, dt_.dt_s);
+        k.setArg(8, at(v_));  // 9: dt (set_time_step_args)
         k.setArg(10, cl_uint2{{arena_at_pred_.s[5], arena_at_pred_.s[6]}});
         k.setArg(11, stress_list_at_);
         k.setArg(12, list_n);
@@ -299,8 +299,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     set_lattice_args(*k, kStepLattice);
     k->setArg(kStepIndenter, at(indenters_));
     set_indenter_times(*k, kStepIndenter, 0.0, 0.0);
-    set_state_arena_arg(*k);
-    set_real(*k, kStepIndenter + kIndenterArgs, dt_.dt_s);
+    set_state_arena_arg(*k);  // then dt (set_time_step_args)
     k->setArg(kStepIndenter + kIndenterArgs + 1, cl_uint(step_list_ ? step_list_n_ : n_));  // VB_STEP_N
   }
   if (lanes_) make_lane_args();
@@ -324,15 +323,25 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     check_.setArg(relax_arg + 1, relax_prev_);
     set_real(relax_kernel_, kStepIndenter + kIndenterArgs + 3, damping_);
   }
-  if (friction) {  // check_state's friction_dt, just before VB_TRI_PARAMS (kernels/checks.cl)
-    const int last = int(check_.getInfo<CL_KERNEL_NUM_ARGS>());
-    set_real(check_, last - 1 - (tri_contact_ ? kTriangleArgs : 0), dt_.dt_s);
-  }
+  if (friction)  // check_state's friction_dt, just before VB_TRI_PARAMS (kernels/checks.cl)
+    check_dt_arg_ = int(check_.getInfo<CL_KERNEL_NUM_ARGS>()) - 1 - (tri_contact_ ? kTriangleArgs : 0);
   if (volume_) make_volume_buffers(surface_, surface_list, surface_index);
   if (!scene.tori.empty()) make_contact_area_buffer();
   if (tri_contact_) make_triangle_contact_buffers();
   if (persistent_.on) make_persistent_kernel();
+  set_time_step_args();
   if (rest_offsets_) set_rest_offsets(std::vector<double>(3 * n_, 0.0));  // R₀ = I, J₀ = 1
+}
+
+void Simulator::set_time_step_args() {
+  for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_})
+    if ((*k)()) set_real(*k, kStepIndenter + kIndenterArgs, dt_.dt_s);
+  if (stress_pair_) {  // element_stress's predicted stage (kernels/hyperelastic.cl)
+    set_real(stress_, 9, dt_.dt_s);
+    set_real(step_stress_, 9, dt_.dt_s);
+  }
+  if (check_dt_arg_ >= 0) set_real(check_, check_dt_arg_, dt_.dt_s);
+  if (persistent_.on) set_persistent_time_step();
 }
 
 // Heun's predicted stage packed (kernels/lattice_forces.cl, stage_load): ũ with ṽx in one real4,
@@ -525,11 +534,8 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
   std::vector<double> table;
   for (const auto& row : el.material_table) table.insert(table.end(), row.begin(), row.end());
   if (!per_tissue) table.assign(12, 0.0);
-  const std::vector<double> marked_E =
-      uniform_path_ ? mark_uniform_neighbourhoods(lattice_, el.youngs_modulus_pa, inverse_mass_, cl_.info.simd_width)
-                    : el.youngs_modulus_pa;
-  uniform_elements_ = std::size_t(std::count_if(marked_E.begin(), marked_E.end(), [](double E) { return E < 0; }));
-  const std::vector<unsigned char> E = real_bytes(marked_E);
+  material_rows_ = per_tissue ? el.material_table.size() : 0;
+  const std::vector<unsigned char> E = real_bytes(device_modulus(el.youngs_modulus_pa));
   const std::vector<unsigned char> materials = real_bytes(table);
   // kernels/hyperelastic.cl, hyper_store: Q's 3 rows (C = FᵀF's diagonal in w), C's other entries
   const std::size_t row_bytes = (hyper_ ? n_ : 1) * 4 * real_size_;
@@ -566,7 +572,16 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
   step_list_at_ = step_list_ ? arena_.offset_units(step_list_slot) : 0;
   E_ = arena_.part(slot[0]);
   cell_ = arena_.part(slot[1]);
+  materials_ = arena_.part(slot[4]);
   rest_offset_ = arena_.part(slot[7]);
+}
+
+std::vector<double> Simulator::device_modulus(const std::vector<double>& youngs_modulus_pa) {
+  std::vector<double> marked =
+      uniform_path_ ? mark_uniform_neighbourhoods(lattice_, youngs_modulus_pa, inverse_mass_, cl_.info.simd_width)
+                    : youngs_modulus_pa;
+  uniform_elements_ = std::size_t(std::count_if(marked.begin(), marked.end(), [](double E) { return E < 0; }));
+  return marked;
 }
 
 std::vector<unsigned char> Simulator::real_bytes(const std::vector<double>& values) const {

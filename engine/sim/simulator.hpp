@@ -91,6 +91,15 @@ class Simulator {
   /// their rest lengths and hyperelastic elements their rest shape from it (docs/PHYSICS.md §13).
   /// Displacements stay measured from the voxel centres (the CT). Zero until set.
   void set_rest_offsets(const std::vector<double>& u0_m);
+  /// New moduli for the same model (a fit's next solve, engine/fit/forward_model.cpp): the moduli
+  /// and material table of `elements`, which must be this model's arrays but for those (the same
+  /// masses, held elements and laws). Recomputes dt and relaxation's mass scale and leaves the
+  /// simulator as a new one built with `elements` starts: the state at their initial
+  /// displacement and at rest, the clock at zero, gravity the scene's, relaxation's damping
+  /// estimate forgotten; rest offsets (set_rest_offsets) stay. Costs two small uploads instead of
+  /// the buffers, program and model a new simulator builds. Throws vb::Error for other masses,
+  /// laws or sizes, and with triangle contact (its penalty follows the moduli).
+  void set_materials(const ElementArrays& elements);
   /// Counts time from zero again (the next run starts at t = 0, indenters at their start).
   void restart_clock() { steps_ = 0; }
 
@@ -199,6 +208,12 @@ class Simulator {
   /// recorded trajectories: switches each indenter's row to the segment holding time t
   void follow_paths(double t_s);
   void set_lattice_args(cl::Kernel& k, int first_arg);
+  /// dt into every kernel that takes it (the stepping kernels, the paired stress pass, the check's
+  /// friction, the one-launch step)
+  void set_time_step_args();
+  int check_dt_arg_ = -1;  ///< check_state's friction_dt (scenes with friction), else −1
+  /// the modulus slot of the model arena as the kernels read it: E, uniform neighbourhoods marked
+  std::vector<double> device_modulus(const std::vector<double>& youngs_modulus_pa);
   /// arguments 1–7 of the per-element gradient fits (tissue ids, materials, grid, spacing)
   void set_element_fit_args(cl::Kernel& k);
   void set_real(cl::Kernel& k, int index, double x) const;
@@ -265,7 +280,7 @@ class Simulator {
                            const cl::Buffer& v_out) const;
   cl::Buffer u_, v_, u_tmp_, v_tmp_, partial_, partial_arg_;
   /// E, cell_of, grid, tissue ids, material table, Q, C, rest offsets (kernels/common.cl,
-  /// VB_UNPACK_LATTICE) and their offsets; E_, cell_, rest_offset_ are the host's views of three.
+  /// VB_UNPACK_LATTICE) and their offsets; E_, cell_, materials_, rest_offset_ are the host's views of four.
   DeviceArena arena_;
   cl_uint8 arena_at_{};
   cl_uint8 arena_at_pred_{};  ///< arena_at_ with the predicted stage's Q and C (stress_pair_), for heun_correct
@@ -273,8 +288,10 @@ class Simulator {
   /// at stress_list_at_), 0 when that is every element
   std::size_t stress_list_n_ = 0;
   cl_uint stress_list_at_ = 0;
-  cl::Buffer E_, cell_;
+  cl::Buffer E_, cell_, materials_;
   bool hyper_ = false;
+  bool biphasic_ = false;  ///< biphasic springs compiled in (VB_BIPHASIC)
+  std::size_t material_rows_ = 0;  ///< material table rows in the arena (0: a placeholder, springs only)
   cl::Buffer indenters_;  ///< rigid-obstacle table: indenters and tori (lattice frame)
   std::vector<IndenterMotion> motion_;  ///< per indenter, what its row holds now
   std::vector<std::size_t> path_segment_;  ///< per indenter with a trajectory: the segment its row holds
@@ -368,6 +385,7 @@ class Simulator {
   void enqueue_persistent_step(double t0_s, double t1_s, bool moving_obstacles, bool project);
   /// V0 (lattice frame) into the persistent kernel (set_rest_volume_args calls it)
   void set_persistent_rest_volume(double v0);
+  void set_persistent_time_step();
   /// throws vb::Error when a grid barrier timed out (work-groups not all resident); check() and
   /// download() call it
   void check_grid_barriers() const;

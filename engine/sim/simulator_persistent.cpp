@@ -35,8 +35,7 @@ void Simulator::make_persistent_kernel() {
   k.setArg(3, v_tmp_);
   set_lattice_args(k, kLattice);
   set_indenter_args(k, kIndenters, 0.0, 0.0);
-  set_real(k, kDt, dt_.dt_s);
-  k.setArg(kDt + 1, cl_uint(n_));
+  k.setArg(kDt + 1, cl_uint(n_));  // kDt: set_persistent_time_step
   k.setArg(kRestFrame, rest_frame_);
   if (volume_) {
     k.setArg(kMesh, vol_mesh_.buffer());
@@ -55,6 +54,8 @@ void Simulator::make_persistent_kernel() {
 }
 
 void Simulator::set_persistent_rest_volume(double v0) { set_real(persistent_kernel_, kRestVolume, v0); }
+
+void Simulator::set_persistent_time_step() { set_real(persistent_kernel_, kDt, dt_.dt_s); }
 
 void Simulator::enqueue_persistent_step(double t0_s, double t1_s, bool moving_obstacles, bool project) {
   cl::Kernel& k = persistent_kernel_;
