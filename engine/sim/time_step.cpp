@@ -1,10 +1,12 @@
 #include "engine/sim/time_step.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 
 #include "engine/error.hpp"
+#include "engine/material/linear_spring.hpp"
 #include "engine/sim/host_reference.hpp"
 #include "engine/sim/triangle_contact.hpp"
 
@@ -12,27 +14,49 @@ namespace vb {
 
 namespace {
 
+/// Σ_b |n_a n_b| for each direction's unit vector n and row a: a connection's share of row a.
+const std::array<std::array<double, 26>, 3>& row_weights() {
+  static const std::array<std::array<double, 26>, 3> w = [] {
+    std::array<std::array<double, 26>, 3> out{};
+    const auto& offsets = neighbour_offsets();
+    for (int d = 0; d < 26; ++d) {
+      const Vec3 n = Vec3(offsets[d][0], offsets[d][1], offsets[d][2]).normalized();
+      for (int a = 0; a < 3; ++a) out[a][d] = std::abs(n[a]) * n.cwiseAbs().sum();
+    }
+    return out;
+  }();
+  return w;
+}
+
 /// Gershgorin row bounds of M⁻¹K and M⁻¹C (dashpots only) of a free element, over its 3 rows;
-/// `extra_k` (N/m) is added to every stiffness row (triangle contact's penalty).
+/// `extra_k` (N/m) is added to every stiffness row (triangle contact's penalty). Every simulator
+/// and every new set of a fit's moduli computes these over the whole lattice, so the neighbours
+/// are looked up once and the dashpots' square roots taken only where they act.
 struct Rows {
   double omega_sq = 0, c_max = 0, k_max = 0;  ///< k_max: the largest stiffness row (N/m)
 };
 Rows element_rows(const Lattice& lattice, const ElementArrays& el, double dashpot_ratio, std::size_t e,
                   double extra_k = 0) {
-  const auto& offsets = neighbour_offsets();
-  const auto k = connection_stiffness(lattice, el.stability_modulus_pa, e);
-  const auto k_dashpot = connection_stiffness(lattice, el.youngs_modulus_pa, e);  // what the dashpots use
   const auto nb = lattice.neighbours(e);
+  const double h = lattice.spacing_m;
+  std::array<double, 26> k{}, c{};  // spring stiffness (the stability modulus's) and dashpot
+  for (int d = 0; d < 26; ++d) {
+    if (nb[d] < 0) continue;
+    const std::size_t j = std::size_t(nb[d]);
+    k[d] = linear_spring::stiffness(d, h, el.stability_modulus_pa[e], el.stability_modulus_pa[j]);
+    if (dashpot_ratio > 0) {  // the dashpots use the spring modulus
+      const double reduced_mass = 1.0 / (el.inverse_mass[e] + el.inverse_mass[j]);
+      c[d] = 2 * dashpot_ratio * std::sqrt(linear_spring::stiffness(d, h, el.youngs_modulus_pa[e], el.youngs_modulus_pa[j]) * reduced_mass);
+    }
+  }
+  const auto& w = row_weights();
   Rows r;
   for (int a = 0; a < 3; ++a) {
     double k_row = 0, c_row = 0;
     for (int d = 0; d < 26; ++d) {
       if (k[d] == 0) continue;
-      const Vec3 n = Vec3(offsets[d][0], offsets[d][1], offsets[d][2]).normalized();
-      const double w = std::abs(n[a]) * n.cwiseAbs().sum();  // Σ_b |n_a n_b|
-      const double reduced_mass = 1.0 / (el.inverse_mass[e] + el.inverse_mass[nb[d]]);
-      k_row += 2 * k[d] * w;
-      c_row += 2 * (2 * dashpot_ratio * std::sqrt(k_dashpot[d] * reduced_mass)) * w;
+      k_row += 2 * k[d] * w[a][d];
+      c_row += 2 * c[d] * w[a][d];
     }
     r.k_max = std::max(r.k_max, k_row);
     r.omega_sq = std::max(r.omega_sq, (k_row + extra_k) * el.inverse_mass[e]);
