@@ -124,7 +124,8 @@ ForwardSolution ForwardModel::solve_timed(const std::vector<double>& E, const Fo
   const Lattice& lat = lattice();
   ++solves_;
   if (unloaded_) {  // the fixed point's solves: all of it counts as relaxation
-    ForwardSolution out = solve_from_unloaded_reference(scene_, lat, el, cl_, warm);
+    if (!reference_sims_) reference_sims_ = std::make_unique<UnloadedReferenceSimulators>();
+    ForwardSolution out = solve_from_unloaded_reference(scene_, lat, el, cl_, warm, *reference_sims_);
     reference_solves_ += std::size_t(out.reference_solves);
     lap(&JacobianTiming::relax_s);
     return out;

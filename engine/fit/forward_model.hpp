@@ -13,6 +13,7 @@
 namespace vb {
 
 class Simulator;
+struct UnloadedReferenceSimulators;
 
 struct ForwardSolution {
   std::vector<double> from_m;  ///< n×3 equilibrium displacement in the `from` posture (m, world); zeros without one
@@ -60,7 +61,7 @@ class ForwardModel {
   /// steps when the moduli changed little). Throws vb::Error when a posture does not reach
   /// equilibrium in fit.max_steps. One simulator serves every solve: built by the first, given
   /// each later solve's moduli (Simulator::set_materials), so a solve equals one on a simulator
-  /// built for it (the unloaded reference state builds its own, reference_forward.hpp).
+  /// built for it (from the unloaded reference state: its two simulators, reference_forward.hpp).
   ForwardSolution solve(const std::vector<double>& region_modulus_pa, const ForwardSolution* warm = nullptr) const;
 
   /// Solves several sets of region moduli (each as solve(moduli[k], warm)) with the copies of the
@@ -113,6 +114,8 @@ class ForwardModel {
   mutable JacobianTiming timing_;
   mutable std::size_t reference_solves_ = 0;
   mutable std::unique_ptr<Simulator> sim_;  ///< solve()'s, built by the first solve
+  /// solve()'s from the unloaded reference state (reference_forward.hpp), likewise
+  mutable std::unique_ptr<UnloadedReferenceSimulators> reference_sims_;
   /// solve_batch's simulators by copies per batch (a Jacobian's full batches and its remainder),
   /// each with the tiled lattice it refers to; built by the first batch of that size
   struct BatchSimulator {

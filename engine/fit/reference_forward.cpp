@@ -30,7 +30,8 @@ bool use_unloaded_reference(const Scene& scene, const FitSpec& fit) {
 }
 
 ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice& lattice, const ElementArrays& el,
-                                              const ClContext& cl, const ForwardSolution* warm) {
+                                              const ClContext& cl, const ForwardSolution* warm,
+                                              UnloadedReferenceSimulators& sims) {
   const std::size_t n = lattice.element_count();
   ForwardSolution out;
   // The fit differences solves whose moduli differ by a few percent: the rest offsets must be
@@ -42,8 +43,14 @@ ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice&
                                                       ? kFitReferenceTolerance_m
                                                       : kFitReferenceToleranceFloat_m);
   tight.reference_state.max_iterations = std::max(scene.reference_state.max_iterations, 50);
-  const ReferenceState ref =
-      estimate_reference_state(tight, lattice, el, cl, warm ? warm->rest_offset_m : std::vector<double>{});
+  if (!sims.reference) {
+    sims.reference_scene = reference_state_scene(tight);
+    sims.reference = std::make_unique<Simulator>(sims.reference_scene, lattice, el, cl);
+  } else {
+    sims.reference->set_materials(el);
+  }
+  const ReferenceState ref = estimate_reference_state(*sims.reference, tight, lattice, el,
+                                                      warm ? warm->rest_offset_m : std::vector<double>{});
   // Not within tolerance after max_iterations: the best estimate is kept (as `simulate` does);
   // the fit's residual then includes the estimate's miss, which ref.residual_max_m bounds.
   out.rest_offset_m = ref.rest_offset_m;
@@ -51,7 +58,9 @@ ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice&
   out.reference_solves = int(ref.history.size());
   out.from_m.assign(3 * n, 0.0);
 
-  Simulator sim(scene, lattice, el, cl);
+  if (!sims.posture) sims.posture = std::make_unique<Simulator>(scene, lattice, el, cl);
+  else sims.posture->set_materials(el);
+  Simulator& sim = *sims.posture;
   sim.set_rest_offsets(ref.rest_offset_m);
   const std::vector<double> still(3 * n, 0.0);
   sim.upload(warm ? warm->to_m : el.displacement_m, still);

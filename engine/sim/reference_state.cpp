@@ -58,10 +58,17 @@ ReferenceState estimate_reference_state(const Scene& scene, const Lattice& latti
 ReferenceState estimate_reference_state(const Scene& scene, const Lattice& lattice, const ElementArrays& el,
                                         const ClContext& cl, const std::vector<double>& first_offset_m,
                                         const std::function<void(const ReferenceIteration&)>& on_iteration) {
+  const Scene ct = reference_state_scene(scene);  // the simulator keeps a reference: it lives as long as sim
+  Simulator sim(ct, lattice, el, cl);
+  return estimate_reference_state(sim, scene, lattice, el, first_offset_m, on_iteration);
+}
+
+ReferenceState estimate_reference_state(Simulator& sim, const Scene& scene, const Lattice& lattice,
+                                        const ElementArrays& el, const std::vector<double>& first_offset_m,
+                                        const std::function<void(const ReferenceIteration&)>& on_iteration) {
   ReferenceState out;
   const auto start = std::chrono::steady_clock::now();
   const Scene ct = reference_state_scene(scene);
-  Simulator sim(ct, lattice, el, cl);
   const std::size_t n = lattice.element_count();
   // The residual is measured over the free elements that can rest at their CT position. The
   // others cannot be corrected by their own miss (it only winds their rest shape up until a solve

@@ -57,4 +57,11 @@ ReferenceState estimate_reference_state(const Scene& scene, const Lattice& latti
                                         const ClContext& cl, const std::vector<double>& first_offset_m,
                                         const std::function<void(const ReferenceIteration&)>& on_iteration = {});
 
+/// The same on the caller's simulator of reference_state_scene(scene) with these element arrays
+/// (built with them, or given them by Simulator::set_materials): a fit keeps one across its
+/// solves (engine/fit/reference_forward.hpp). Its rest offsets and state are the iteration's.
+ReferenceState estimate_reference_state(Simulator& sim, const Scene& scene, const Lattice& lattice,
+                                        const ElementArrays& elements, const std::vector<double>& first_offset_m,
+                                        const std::function<void(const ReferenceIteration&)>& on_iteration = {});
+
 }  // namespace vb

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "engine/fit/forward_model.hpp"
@@ -53,6 +54,32 @@ TEST_P(ForwardModelSolves, EachEqualsTheSolveOfAModelBuiltForIt) {
     expect_same(column[0], fresh.solve(moduli(3000 * 1.05, 15000), &first));
   }
   EXPECT_NE(second.to_m, third.to_m);  // the moduli moved the solution (the comparison sees them)
+}
+
+// From the unloaded reference state the fixed point's simulator and the posture's are kept too.
+TEST(ForwardModelUnloadedReference, EachSolveEqualsTheSolveOfAModelBuiltForIt) {
+  Scene s = test::fit_box_scene(test::material("soft", 3000), test::material("tumour", 15000));
+  s.reference_state.active = true;
+  s.reference_state.ct_gravity_m_s2 = Vec3(0, 9.81, 0);  // the image was taken in the `from` posture
+  const Lattice lattice = build_lattice(voxelise_shapes(s));
+  FitSpec f = test::fit_box_spec();
+  f.from_gravity_m_s2.reset();  // the image posture is [reference_state]'s
+  const FitRegions regions = make_fit_regions(f, s, lattice);
+  ASSERT_EQ(regions.size(), 2u);
+  const ForwardModel kept(s, lattice, regions, f, test::cl_context());
+  ASSERT_TRUE(kept.unloaded_reference());
+  const ForwardSolution first = kept.solve({3000, 15000});
+  const ForwardSolution second = kept.solve({2000, 30000}, &first);
+  const ForwardSolution third = kept.solve({4500, 9000});
+  for (const auto& [E, warm, solution] : {std::tuple{std::vector<double>{2000, 30000}, &first, &second},
+                                           std::tuple{std::vector<double>{4500, 9000}, (const ForwardSolution*)nullptr, &third}}) {
+    const ForwardModel fresh(s, lattice, regions, f, test::cl_context());
+    const ForwardSolution alone = fresh.solve(E, warm);
+    expect_same(*solution, alone);
+    EXPECT_EQ(solution->rest_offset_m, alone.rest_offset_m);
+    EXPECT_EQ(solution->reference_solves, alone.reference_solves);
+  }
+  EXPECT_NE(second.to_m, third.to_m);
 }
 
 // Batches keep their simulators too, one per batch size: a second Jacobian's batches equal the
