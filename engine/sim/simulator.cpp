@@ -132,10 +132,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   if (rest_offsets_) device_bytes_ += offset_bytes + (hyper_ ? frame_bytes : 0);
   make_model_arena(el, grid, cell_of, offset_bytes);
   plan_pred_packing(scene, el, cl);  // after the short loop's marks
-  for (const IndenterSpec& ind : scene.indenters) {  // before the obstacle table (state arena)
-    motion_.push_back({ind.start_m, ind.velocity_m_s, 0.0, ind.travel_time_s});
-    if (!ind.path.empty()) motion_.back() = {ind.path.front().position_m, Vec3::Zero(), 0.0, 0.0};
-  }
+  for (const IndenterSpec& ind : scene.indenters) motion_.push_back(starting_motion(ind));  // before the obstacle table
   path_segment_.assign(scene.indenters.size(), std::size_t(-1));
   // the volume constraint's surface elements, one work-item each (kernels/volume.cl: the volume
   // from Euler's theorem); the state arena sizes the partial sums by them

@@ -95,10 +95,11 @@ class Simulator {
   /// and material table of `elements`, which must be this model's arrays but for those (the same
   /// masses, held elements and laws). Recomputes dt and relaxation's mass scale and leaves the
   /// simulator as a new one built with `elements` starts: the state at their initial
-  /// displacement and at rest, the clock at zero, gravity the scene's, relaxation's damping
-  /// estimate forgotten; rest offsets (set_rest_offsets) stay. Costs two small uploads instead of
-  /// the buffers, program and model a new simulator builds. Throws vb::Error for other masses,
-  /// laws or sizes, and with triangle contact (its penalty follows the moduli).
+  /// displacement and at rest, the clock at zero, gravity and indenter motions the scene's,
+  /// relaxation's damping estimate forgotten; rest offsets (set_rest_offsets) stay. Costs the
+  /// host's stability bounds and a few uploads, not the buffers, program and model a new
+  /// simulator builds. Throws vb::Error for other masses, laws or sizes, and with triangle
+  /// contact (its penalty follows the moduli).
   void set_materials(const ElementArrays& elements);
   /// Counts time from zero again (the next run starts at t = 0, indenters at their start).
   void restart_clock() { steps_ = 0; }
@@ -201,6 +202,8 @@ class Simulator {
 
  private:
   void set_indenter_args(cl::Kernel& k, int first_arg, double t_force, double t_project);
+  /// where the scene starts an indenter: its constant-velocity press, or held at its path's first knot
+  static IndenterMotion starting_motion(const IndenterSpec& indenter);
   /// the stage times alone (the table argument set once)
   void set_indenter_times(cl::Kernel& k, int first_arg, double t_force, double t_project);
   /// one indenter's row of the obstacle table (lattice frame, kernels/common.cl)

@@ -1,6 +1,7 @@
 // New moduli for a built model (Simulator::set_materials): what depends on them is the arena's
 // modulus slot and material table, dt and relaxation's mass scale; everything else a simulator
-// builds (buffers, program, grid, surface) is the model's geometry and stays.
+// builds (buffers, program, grid, surface) is the model's geometry and stays, and its state,
+// clock, gravity, indenters and relaxation estimate go back to where a new simulator starts them.
 #include <cmath>
 
 #include "engine/error.hpp"
@@ -35,6 +36,8 @@ void Simulator::set_materials(const ElementArrays& el) {
   set_time_step_args();
   steps_ = 0;
   if (scene_.gravity.active) set_gravity(scene_.gravity.acceleration_m_s2);
+  for (std::size_t i = 0; i < scene_.indenters.size(); ++i) set_indenter_motion(i, starting_motion(scene_.indenters[i]));
+  path_segment_.assign(scene_.indenters.size(), std::size_t(-1));
   upload(el.displacement_m, std::vector<double>(3 * n_, 0.0));
   if (relax_) {
     const std::vector<unsigned char> scale = real_bytes(relaxation_mass_scale(lattice_, el));

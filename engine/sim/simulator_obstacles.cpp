@@ -46,6 +46,11 @@ std::vector<double> Simulator::indenter_row(std::size_t i) const {
   return row;
 }
 
+IndenterMotion Simulator::starting_motion(const IndenterSpec& ind) {
+  if (!ind.path.empty()) return {ind.path.front().position_m, Vec3::Zero(), 0.0, 0.0};  // follow_paths moves it
+  return {ind.start_m, ind.velocity_m_s, 0.0, ind.travel_time_s};
+}
+
 void Simulator::set_indenter_motion(std::size_t i, const IndenterMotion& motion) {
   require(i < scene_.indenters.size(), "no indenter " + std::to_string(i) + " in the scene", "indenter");
   motion_[i] = motion;

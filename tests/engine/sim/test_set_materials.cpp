@@ -22,6 +22,7 @@ struct Case {
   const char* law;  ///< of every tissue
   bool volume;
   Precision precision;
+  bool indenter = false;  ///< a plate pressing on the top
 };
 
 std::string case_name(const ::testing::TestParamInfo<Case>& info) { return info.param.name; }
@@ -39,6 +40,7 @@ Scene case_scene(const Case& c) {
       m = material_with_modulus(ogden, m.youngs_modulus_pa);
     }
   }
+  if (c.indenter) s.indenters.push_back(test::plate_pair(10, 0.004, 0.97)[1]);
   return s;
 }
 
@@ -81,7 +83,8 @@ TEST_P(SetMaterials, StepsExactlyAsASimulatorBuiltWithTheNewModuli) {
 
   Simulator kept(base, lattice, make_element_arrays(base, lattice), cl_context());
   step(kept);  // a used simulator: state, clock and relaxation's estimate all moved
-  kept.set_gravity(Vec3(0, 9.81, 0));  // set_materials puts the scene's gravity back
+  kept.set_gravity(Vec3(0, 9.81, 0));  // set_materials puts the scene's gravity and indenters back
+  if (GetParam().indenter) kept.place_indenter(0, Vec3(0, 0, 0.01));
   Stepped prev;
   for (std::size_t k = 0; k < scenes.size(); ++k) {
     SCOPED_TRACE("moduli set " + std::to_string(k));
@@ -105,6 +108,7 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"RelaxationNeoHookeanFloat", Integrator::Relaxation, "neo-hookean", false, Precision::Float},
                       Case{"RelaxationLinearVolume", Integrator::Relaxation, "linear", true, Precision::Double},
                       Case{"HeunLinearFloat", Integrator::Heun, "linear", false, Precision::Float},
+                      Case{"HeunLinearPlate", Integrator::Heun, "linear", false, Precision::Double, true},
                       Case{"HeunOgdenVolume", Integrator::Heun, "ogden", true, Precision::Double},
                       Case{"EulerBiphasic", Integrator::SymplecticEuler, "biphasic", false, Precision::Double}),
     case_name);
