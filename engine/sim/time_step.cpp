@@ -7,7 +7,6 @@
 
 #include "engine/error.hpp"
 #include "engine/material/linear_spring.hpp"
-#include "engine/sim/host_reference.hpp"
 #include "engine/sim/triangle_contact.hpp"
 
 namespace vb {
