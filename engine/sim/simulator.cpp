@@ -285,7 +285,8 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     correct_ = cl::Kernel(program_, lanes_ ? "heun_correct_lanes" : "heun_correct");
   } else if (relax_) {
     relax_kernel_ = cl::Kernel(program_, lanes_ ? "relax_step_lanes" : "relax_step");
-    relax_scale_ = make_real_buffer(relaxation_mass_scale(lattice, el, penalty.row_n_m));
+    relax_scale_ = make_real_buffer(relaxation_mass_scale(el, dt_.row_stiffness_n_m, penalty.row_n_m));
+    dt_.row_stiffness_n_m = {};  // the host copy is not needed again
     relax_kernel_.setArg(kStepIndenter + kIndenterArgs + 2, relax_scale_);
   } else {
     euler_ = cl::Kernel(program_, lanes_ ? "euler_step_lanes" : "euler_step");

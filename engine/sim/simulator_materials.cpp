@@ -40,7 +40,8 @@ void Simulator::set_materials(const ElementArrays& el) {
   path_segment_.assign(scene_.indenters.size(), std::size_t(-1));
   upload(el.displacement_m, std::vector<double>(3 * n_, 0.0));
   if (relax_) {
-    const std::vector<unsigned char> scale = real_bytes(relaxation_mass_scale(lattice_, el));
+    const std::vector<unsigned char> scale = real_bytes(relaxation_mass_scale(el, dt_.row_stiffness_n_m));
+    dt_.row_stiffness_n_m = {};
     cl_.queue.enqueueWriteBuffer(relax_scale_, CL_TRUE, 0, scale.size(), scale.data());
     // as the constructor leaves it: no estimate of ω_min² yet, no damping, and the previous
     // check's state the rest state (zeros), valid while the held elements sit there

@@ -90,15 +90,23 @@ std::vector<double> element_row_stiffness_n_m(const Lattice& lattice, const Elem
 
 std::vector<double> relaxation_mass_scale(const Lattice& lattice, const ElementArrays& el,
                                           const std::vector<double>& extra_row_n_m) {
-  std::vector<double> scale(lattice.element_count(), 1.0), omega_sq(lattice.element_count(), 0.0);
+  return relaxation_mass_scale(el, element_row_stiffness_n_m(lattice, el), extra_row_n_m);
+}
+
+std::vector<double> relaxation_mass_scale(const ElementArrays& el, const std::vector<double>& k_row,
+                                          const std::vector<double>& extra_row_n_m) {
+  // An element's bound is its largest row times its inverse mass, (k + extra)/m: rounding is
+  // monotone, so this is the largest of element_rows' per-row bounds to the bit.
+  const std::size_t n = k_row.size();
+  std::vector<double> scale(n, 1.0), omega_sq(n, 0.0);
   double highest = 0;  // of the elastic rows: the penalty makes its elements heavier, not the step shorter
-  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+  for (std::size_t e = 0; e < n; ++e) {
     if (el.inverse_mass[e] == 0) continue;
-    omega_sq[e] = element_rows(lattice, el, 0, e).omega_sq;
+    omega_sq[e] = k_row[e] * el.inverse_mass[e];
     highest = std::max(highest, omega_sq[e]);
-    if (!extra_row_n_m.empty()) omega_sq[e] = element_rows(lattice, el, 0, e, extra_row_n_m[e]).omega_sq;
+    if (!extra_row_n_m.empty()) omega_sq[e] = (k_row[e] + extra_row_n_m[e]) * el.inverse_mass[e];
   }
-  for (std::size_t e = 0; e < lattice.element_count(); ++e)
+  for (std::size_t e = 0; e < n; ++e)
     if (omega_sq[e] > 0) scale[e] = highest / omega_sq[e];
   return scale;
 }
@@ -148,8 +156,13 @@ TimeStepChoice choose_time_step(const Scene& scene, const Lattice& lattice, cons
   TimeStepChoice choice;
   const SolverSpec& s = scene.solver;
   if (s.integrator == Integrator::Relaxation) {
-    // Symplectic Euler without dashpots (they do not act), every element at the bound ω_max.
-    choice.bounds = stability_bounds(lattice, el, 0, 0);
+    // Symplectic Euler without dashpots (they do not act), every element at the bound ω_max:
+    // the largest row over inverse mass, as stability_bounds(…, 0, 0) gives it.
+    choice.row_stiffness_n_m = element_row_stiffness_n_m(lattice, el);
+    double omega_sq = 0;
+    for (std::size_t e = 0; e < lattice.element_count(); ++e)
+      omega_sq = std::max(omega_sq, choice.row_stiffness_n_m[e] * el.inverse_mass[e]);
+    choice.bounds.omega_max = std::sqrt(omega_sq);
     choice.stable_limit_s = stable_time_step(Integrator::SymplecticEuler, choice.bounds, 0);
   } else {
     // Triangle contact's penalty adds its stiffness to the surface elements' rows (relaxation

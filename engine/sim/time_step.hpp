@@ -28,6 +28,10 @@ std::vector<double> element_row_stiffness_n_m(const Lattice& lattice, const Elem
 /// step stays.
 std::vector<double> relaxation_mass_scale(const Lattice& lattice, const ElementArrays& elements,
                                           const std::vector<double>& extra_row_n_m = {});
+/// The same from each element's largest stiffness row (element_row_stiffness_n_m, which a
+/// relaxation scene's TimeStepChoice holds), so a simulator walks the lattice once for both.
+std::vector<double> relaxation_mass_scale(const ElementArrays& elements, const std::vector<double>& row_stiffness_n_m,
+                                          const std::vector<double>& extra_row_n_m = {});
 
 /// Largest dt for which the integrator is stable on ẍ = −ω²x − c(ω)ẋ for all ω ≤ ω_max, with
 /// c(ω) = γ + (c_max − γ)(ω/ω_max)² (dashpots are stiffness-proportional, global damping not).
@@ -42,6 +46,9 @@ struct TimeStepChoice {
   bool automatic = true;
   double stable_limit_s = 0;  ///< the bound's stable step (s)
   StabilityBounds bounds;
+  /// relaxation scenes only: element_row_stiffness_n_m, the rows the bounds came from (the
+  /// mass scale is made from them too); empty otherwise
+  std::vector<double> row_stiffness_n_m;
 };
 
 /// dt from the scene: "auto" → dt_safety × stable limit; an explicit dt is used as given.

@@ -43,5 +43,46 @@ TEST(TimeStep, HeunWithoutDampingHasNoAutomaticStep) {
   EXPECT_THROW(choose_time_step(s, m.lattice, m.elements), Error);
 }
 
+
+// Relaxation walks the lattice once (the rows kept in its TimeStepChoice): its ω_max must be
+// stability_bounds' without dashpots to the bit, and the mass scale made from the kept rows must
+// put every free element's bound (k + penalty)/m̃ at ω_max², held ones at scale 1.
+TEST(TimeStep, RelaxationBoundsAndMassScaleComeFromOneWalk) {
+  Scene s = test::box_scene(6, 4, 4, 0.003);
+  ShapeSpec stiff = s.model.shapes[0];
+  stiff.max_m.x() = 0.009;
+  stiff.label = "stiff";
+  s.model.shapes.push_back(stiff);
+  s.materials["stiff"] = test::material("stiff", 20000);
+  s.anchors.push_back(test::halfspace_anchor("bottom", Vec3(0, 0, 0.003), Vec3(0, 0, -1)));
+  s.solver.integrator = Integrator::Relaxation;
+  const auto m = test::make_model(s);
+  const TimeStepChoice relax = choose_time_step(s, m.lattice, m.elements);
+  ASSERT_EQ(relax.row_stiffness_n_m.size(), m.lattice.element_count());
+  EXPECT_EQ(relax.bounds.omega_max, stability_bounds(m.lattice, m.elements, 0, 0).omega_max);
+  EXPECT_EQ(relax.bounds.damping_max, 0.0);
+  EXPECT_EQ(relax.row_stiffness_n_m, element_row_stiffness_n_m(m.lattice, m.elements));
+
+  std::vector<double> penalty(m.lattice.element_count());
+  for (std::size_t e = 0; e < penalty.size(); ++e) penalty[e] = 50.0 * double(e % 7);
+  const std::vector<double> scale = relaxation_mass_scale(m.elements, relax.row_stiffness_n_m, penalty);
+  const double w2 = relax.bounds.omega_max * relax.bounds.omega_max;
+  std::size_t held = 0;
+  for (std::size_t e = 0; e < scale.size(); ++e) {
+    const double im = m.elements.inverse_mass[e];
+    if (im == 0) {
+      EXPECT_EQ(scale[e], 1.0) << e;
+      ++held;
+      continue;
+    }
+    EXPECT_NEAR((relax.row_stiffness_n_m[e] + penalty[e]) * im * scale[e] / w2, 1.0, 1e-12) << e;
+  }
+  EXPECT_GT(held, 0u);
+  EXPECT_EQ(relaxation_mass_scale(m.elements, relax.row_stiffness_n_m), relaxation_mass_scale(m.lattice, m.elements));
+  s.solver.integrator = Integrator::Heun;
+  s.solver.dashpot_ratio = 0.1;
+  EXPECT_TRUE(choose_time_step(s, m.lattice, m.elements).row_stiffness_n_m.empty());
+}
+
 }  // namespace
 }  // namespace vb
