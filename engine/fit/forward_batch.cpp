@@ -85,12 +85,7 @@ std::vector<ForwardSolution> ForwardModel::solve_batch(const std::vector<std::ve
                                                        const ForwardSolution* warm) const {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  auto mark = start;
-  const auto lap = [&](double JacobianTiming::*phase) {  // time since the last lap into `phase`
-    const auto now = Clock::now();
-    timing_.*phase += std::chrono::duration<double>(now - mark).count();
-    mark = now;
-  };
+  PhaseLaps lap(&timing_);
   ++timing_.jacobians;
   timing_.columns += moduli.size();
   std::vector<ForwardSolution> out;
@@ -101,8 +96,8 @@ std::vector<ForwardSolution> ForwardModel::solve_batch(const std::vector<std::ve
   for (std::size_t first = 0; first < moduli.size(); first += most) {
     const std::size_t K = std::min(most, moduli.size() - first);
     if (K == 1) {
-      out.push_back(solve_timed(moduli[first], warm, &timing_));
-      mark = Clock::now();
+      out.push_back(solve_timed(moduli[first], warm, &timing_));  // it laps its own phases
+      lap.restart();
       continue;
     }
     std::vector<ElementArrays> parts;

@@ -1,7 +1,6 @@
 #include "engine/fit/forward_model.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <map>
 
@@ -113,21 +112,15 @@ ForwardSolution ForwardModel::solve(const std::vector<double>& E, const ForwardS
 
 ForwardSolution ForwardModel::solve_timed(const std::vector<double>& E, const ForwardSolution* warm,
                                           JacobianTiming* timing) const {
-  using Clock = std::chrono::steady_clock;
-  auto mark = Clock::now();
-  const auto lap = [&](double JacobianTiming::*phase) {  // time since the last lap into `phase`
-    const auto now = Clock::now();
-    if (timing) timing->*phase += std::chrono::duration<double>(now - mark).count();
-    mark = now;
-  };
+  PhaseLaps lap(timing);
   const ElementArrays el = arrays(E);
   const Lattice& lat = lattice();
   ++solves_;
-  if (unloaded_) {  // the fixed point's solves: all of it counts as relaxation
+  if (unloaded_) {
     if (!reference_sims_) reference_sims_ = std::make_unique<UnloadedReferenceSimulators>();
-    ForwardSolution out = solve_from_unloaded_reference(scene_, lat, el, cl_, warm, *reference_sims_);
+    lap(&JacobianTiming::setup_s);
+    ForwardSolution out = solve_from_unloaded_reference(scene_, lat, el, cl_, warm, *reference_sims_, timing);
     reference_solves_ += std::size_t(out.reference_solves);
-    lap(&JacobianTiming::relax_s);
     return out;
   }
   const bool build = !sim_;

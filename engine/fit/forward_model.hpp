@@ -1,6 +1,7 @@
 #pragma once
 /// The forward model of a fit: region moduli → the displacement of the posture change, solved to
 /// static equilibrium with dynamic relaxation (docs/FIT.md, "Forward model").
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -43,6 +44,23 @@ struct JacobianTiming {
   std::int64_t steps = 0;      ///< relaxation steps launched (a batch's steps count once for all its copies)
   double element_steps = 0;    ///< Σ steps × elements relaxed: the work
   std::int64_t most_column_steps = 0;  ///< sequential: the most steps of one column; batched: of one batch
+};
+
+/// Adds the time since its previous lap (or its construction) to one phase of a JacobianTiming;
+/// without one it only keeps time.
+class PhaseLaps {
+ public:
+  explicit PhaseLaps(JacobianTiming* timing) : timing_(timing) {}
+  void operator()(double JacobianTiming::*phase) {
+    const auto now = std::chrono::steady_clock::now();
+    if (timing_) timing_->*phase += std::chrono::duration<double>(now - mark_).count();
+    mark_ = now;
+  }
+  void restart() { mark_ = std::chrono::steady_clock::now(); }  ///< the time since counts to no phase
+
+ private:
+  JacobianTiming* timing_;
+  std::chrono::steady_clock::time_point mark_ = std::chrono::steady_clock::now();
 };
 
 class ForwardModel {

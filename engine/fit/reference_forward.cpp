@@ -31,7 +31,8 @@ bool use_unloaded_reference(const Scene& scene, const FitSpec& fit) {
 
 ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice& lattice, const ElementArrays& el,
                                               const ClContext& cl, const ForwardSolution* warm,
-                                              UnloadedReferenceSimulators& sims) {
+                                              UnloadedReferenceSimulators& sims, JacobianTiming* timing) {
+  PhaseLaps lap(timing);
   const std::size_t n = lattice.element_count();
   ForwardSolution out;
   // The fit differences solves whose moduli differ by a few percent: the rest offsets must be
@@ -43,14 +44,19 @@ ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice&
                                                       ? kFitReferenceTolerance_m
                                                       : kFitReferenceToleranceFloat_m);
   tight.reference_state.max_iterations = std::max(scene.reference_state.max_iterations, 50);
+  const std::size_t built = std::size_t(!sims.reference) + std::size_t(!sims.posture);
   if (!sims.reference) {
     sims.reference_scene = reference_state_scene(tight);
     sims.reference = std::make_unique<Simulator>(sims.reference_scene, lattice, el, cl);
   } else {
     sims.reference->set_materials(el);
   }
+  if (!sims.posture) sims.posture = std::make_unique<Simulator>(scene, lattice, el, cl);
+  else sims.posture->set_materials(el);
+  lap(&JacobianTiming::setup_s);
   const ReferenceState ref = estimate_reference_state(*sims.reference, tight, lattice, el,
                                                       warm ? warm->rest_offset_m : std::vector<double>{});
+  lap(&JacobianTiming::relax_s);
   // Not within tolerance after max_iterations: the best estimate is kept (as `simulate` does);
   // the fit's residual then includes the estimate's miss, which ref.residual_max_m bounds.
   out.rest_offset_m = ref.rest_offset_m;
@@ -58,16 +64,23 @@ ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice&
   out.reference_solves = int(ref.history.size());
   out.from_m.assign(3 * n, 0.0);
 
-  if (!sims.posture) sims.posture = std::make_unique<Simulator>(scene, lattice, el, cl);
-  else sims.posture->set_materials(el);
   Simulator& sim = *sims.posture;
   sim.set_rest_offsets(ref.rest_offset_m);
   const std::vector<double> still(3 * n, 0.0);
   sim.upload(warm ? warm->to_m : el.displacement_m, still);
+  lap(&JacobianTiming::upload_s);
   out.steps += relax_to_equilibrium(sim, scene, equilibrium_scales(lattice, el),
                                     scene.gravity.acceleration_m_s2, "to");
+  lap(&JacobianTiming::relax_s);
   std::vector<double> v;
   sim.download(out.to_m, v);
+  lap(&JacobianTiming::readback_s);
+  if (timing) {
+    timing->simulators += built;
+    timing->steps += out.steps;
+    timing->element_steps += double(out.steps) * double(n);
+    timing->most_column_steps = std::max(timing->most_column_steps, out.steps);
+  }
   return out;
 }
 

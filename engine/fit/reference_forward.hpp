@@ -30,8 +30,10 @@ struct UnloadedReferenceSimulators {
 /// the scene's gravity from the image (warm: from warm's state), on `sims`. `from_m` is zero (the
 /// image is the equilibrium in the CT posture, within [reference_state] tolerance_mm), so the
 /// posture change is `to_m`. Throws vb::Error when a solve does not reach equilibrium.
+/// `timing`: the phases' times and the steps added to it (the fixed point's solves count as
+/// relaxation, their simulator's new moduli as setup).
 ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice& lattice, const ElementArrays& elements,
                                               const ClContext& cl, const ForwardSolution* warm,
-                                              UnloadedReferenceSimulators& sims);
+                                              UnloadedReferenceSimulators& sims, JacobianTiming* timing = nullptr);
 
 }  // namespace vb

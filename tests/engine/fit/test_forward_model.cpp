@@ -80,6 +80,19 @@ TEST(ForwardModelUnloadedReference, EachSolveEqualsTheSolveOfAModelBuiltForIt) {
     EXPECT_EQ(solution->reference_solves, alone.reference_solves);
   }
   EXPECT_NE(second.to_m, third.to_m);
+  // A Jacobian's column on the kept simulators: its phases and steps in jacobian_timing.
+  const std::vector<ForwardSolution> column = kept.solve_batch({{3000 * 1.05, 15000}}, &first);
+  const JacobianTiming& t = kept.jacobian_timing();
+  ASSERT_EQ(column.size(), 1u);
+  EXPECT_EQ(t.simulators, 0u);
+  EXPECT_EQ(t.steps, column[0].steps);
+  EXPECT_GT(column[0].reference_solves, 0);
+  EXPECT_GT(t.setup_s, 0.0);
+  EXPECT_GT(t.relax_s, 0.0);
+  EXPECT_GT(t.readback_s, 0.0);
+  const ForwardModel fresh(s, lattice, regions, f, test::cl_context());
+  fresh.solve_batch({{3000 * 1.05, 15000}}, &first);
+  EXPECT_EQ(fresh.jacobian_timing().simulators, 2u);  // the fixed point's and the posture's
 }
 
 // Batches keep their simulators too, one per batch size: a second Jacobian's batches equal the
