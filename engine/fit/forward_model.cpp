@@ -149,12 +149,7 @@ ForwardSolution ForwardModel::solve_timed(const std::vector<double>& E, const Fo
   lap(&JacobianTiming::relax_s);
   sim.download(out.to_m, v);
   lap(&JacobianTiming::readback_s);
-  if (timing) {
-    timing->simulators += build;
-    timing->steps += out.steps;
-    timing->element_steps += double(out.steps) * double(n);
-    timing->most_column_steps = std::max(timing->most_column_steps, out.steps);
-  }
+  if (timing) timing->add_solve(out.steps, n, build);
   return out;
 }
 

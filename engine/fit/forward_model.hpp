@@ -1,6 +1,7 @@
 #pragma once
 /// The forward model of a fit: region moduli → the displacement of the posture change, solved to
 /// static equilibrium with dynamic relaxation (docs/FIT.md, "Forward model").
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <map>
@@ -44,6 +45,14 @@ struct JacobianTiming {
   std::int64_t steps = 0;      ///< relaxation steps launched (a batch's steps count once for all its copies)
   double element_steps = 0;    ///< Σ steps × elements relaxed: the work
   std::int64_t most_column_steps = 0;  ///< sequential: the most steps of one column; batched: of one batch
+
+  /// One sequential solve's count: its steps over n elements, `built` simulators
+  void add_solve(std::int64_t solve_steps, std::size_t n, std::size_t built) {
+    simulators += built;
+    steps += solve_steps;
+    element_steps += double(solve_steps) * double(n);
+    most_column_steps = std::max(most_column_steps, solve_steps);
+  }
 };
 
 /// Adds the time since its previous lap (or its construction) to one phase of a JacobianTiming;

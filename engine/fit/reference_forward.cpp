@@ -75,12 +75,7 @@ ForwardSolution solve_from_unloaded_reference(const Scene& scene, const Lattice&
   std::vector<double> v;
   sim.download(out.to_m, v);
   lap(&JacobianTiming::readback_s);
-  if (timing) {
-    timing->simulators += built;
-    timing->steps += out.steps;
-    timing->element_steps += double(out.steps) * double(n);
-    timing->most_column_steps = std::max(timing->most_column_steps, out.steps);
-  }
+  if (timing) timing->add_solve(out.steps, n, built);
   return out;
 }
 

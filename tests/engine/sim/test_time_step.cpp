@@ -43,19 +43,11 @@ TEST(TimeStep, HeunWithoutDampingHasNoAutomaticStep) {
   EXPECT_THROW(choose_time_step(s, m.lattice, m.elements), Error);
 }
 
-
 // Relaxation walks the lattice once (the rows kept in its TimeStepChoice): its ω_max must be
 // stability_bounds' without dashpots to the bit, and the mass scale made from the kept rows must
 // put every free element's bound (k + penalty)/m̃ at ω_max², held ones at scale 1.
 TEST(TimeStep, RelaxationBoundsAndMassScaleComeFromOneWalk) {
-  Scene s = test::box_scene(6, 4, 4, 0.003);
-  ShapeSpec stiff = s.model.shapes[0];
-  stiff.max_m.x() = 0.009;
-  stiff.label = "stiff";
-  s.model.shapes.push_back(stiff);
-  s.materials["stiff"] = test::material("stiff", 20000);
-  s.anchors.push_back(test::halfspace_anchor("bottom", Vec3(0, 0, 0.003), Vec3(0, 0, -1)));
-  s.solver.integrator = Integrator::Relaxation;
+  Scene s = test::mixed_block(Integrator::Relaxation, false);  // two moduli, two masses, a held base
   const auto m = test::make_model(s);
   const TimeStepChoice relax = choose_time_step(s, m.lattice, m.elements);
   ASSERT_EQ(relax.row_stiffness_n_m.size(), m.lattice.element_count());
