@@ -118,23 +118,31 @@ VB_INLINE real torus_distance(real4 x, global const real* table, global const re
 
 // Frictionless unilateral contact of an element within REAL_CONTACT_TOL·h of the tube surface (or
 // inside): the torus carries the inward normal part of f (a force, or the acceleration f/m: the
-// same constraint), which is removed from f and returned (the force on the torus, N, for a
-// force). With friction, μ·|f_n| is added to the grip.
-VB_INLINE real4 torus_constrain(real4* f, real4 x, global const real* table, global const real* tor, real t, real h,
-                                torus_grip* grip) {
+// same constraint) that would take the element into the tube, which is removed from f and returned
+// (the force on the torus, N, for a force). With friction, μ·|f_n| is added to the grip.
+// In a stage the element (at x, velocity v) ends near x + lead·v + gain·a, so an element still
+// off the surface keeps the inward acceleration that at most brings it onto the surface: without
+// that, one whose free equilibrium lies inside the band coasted out to the band's edge with its
+// restoring force removed and fell back, a cycle that never settled (docs/PHYSICS.md, "Indenters",
+// landing rule). gain 0 (the check): the torus carries the whole inward part within the band.
+VB_INLINE real4 torus_constrain(real4* f, real4 x, real4 v, real lead, real gain, global const real* table,
+                                global const real* tor, real t, real h, torus_grip* grip) {
   const real4 rad = torus_radii(table, tor, t);
   if (!torus_near(x, tor, rad, REAL_CONTACT_TOL * h)) return (real4)(0);
   real4 n, w;
   const real dist = torus_distance_at(x, tor, rad, &n, &w);
   const real fn = dot3(*f, n);
-  const real push = dist <= REAL_CONTACT_TOL * h && fn < 0 ? fn : (real)0;  // ≤ 0
+  const real land = gain > 0 ? -(dist + lead * dot3(v - w, n)) / gain : (real)0;  // lands on the surface
+  const real keep = fmin((real)0, fmax(fn, land));
+  const real push = dist <= REAL_CONTACT_TOL * h && fn < 0 ? fn - keep : (real)0;  // ≤ 0
   *f -= push * n;
   grip_add(grip, push, tor[3], n, w);
   return push * n;
 }
 
-VB_INLINE void torus_constrain_all(real4* f, real4 x, global const real* table, real t, real h, torus_grip* grip) {
-  for (int i = 0; i < VB_TORI; ++i) torus_constrain(f, x, table, torus_row(table, i), t, h, grip);
+VB_INLINE void torus_constrain_all(real4* f, real4 x, real4 v, real lead, real gain, global const real* table, real t,
+                                   real h, torus_grip* grip) {
+  for (int i = 0; i < VB_TORI; ++i) torus_constrain(f, x, v, lead, gain, table, torus_row(table, i), t, h, grip);
 }
 
 // Moves an element that ended a stage inside a tube back onto its surface; its normal velocity

@@ -30,12 +30,14 @@ VB_INLINE real4 less_lag(real4 f, uint e, VB_LAG_PARAMS) { return lag ? fma((rea
 #endif
 
 // Acceleration of free element e from its lattice force f (N): gravity, global damping and the
-// indenters' constraint added as static_force and acceleration add them.
+// indenters' constraint added as static_force and acceleration add them. The stage ends near
+// x + lead·v + gain·a (the push indenters' landing rule: contact_constrain).
 // `grip` collects the indenters' friction (device_contact.cl), turned into m/s² like the torus's.
 // With VB_TRI_CONTACT the triangle-contact forces (triangle_contact.cl, computed for the same u
 // just before this kernel) are added, and with friction their grip; VB_TRI_PARAMS is empty otherwise.
 VB_INLINE real4 acceleration_from(real4 f, uint e, real4 ui, real4 vi, VB_LATTICE_PARAMS,
-                                  global const real* indenters, real t, torus_grip* grip VB_TRI_PARAMS) {
+                                  global const real* indenters, real t, real lead, real gain,
+                                  torus_grip* grip VB_TRI_PARAMS) {
 #if VB_GRAVITY
   f += xyz0(gravity) / ui.w;
 #endif
@@ -46,16 +48,11 @@ VB_INLINE real4 acceleration_from(real4 f, uint e, real4 ui, real4 vi, VB_LATTIC
   f -= damping * xyz0(vi) / ui.w;
 #endif
 #if VB_INDENTERS
-  contact_constrain_all(&f, rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui), indenters, t, h, grip);
+  contact_constrain_all(&f, rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui), vi, lead, gain * ui.w, indenters, t,
+                        h, grip);
 #endif
   grip->grip_n *= ui.w;
   return f * ui.w;
-}
-
-VB_INLINE real4 acceleration(uint e, real4 ui, real4 vi, global const real4* u, global const real4* v,
-                             VB_LATTICE_PARAMS, global const real* indenters, real t, torus_grip* grip VB_TRI_PARAMS) {
-  return acceleration_from(lattice_force(e, ui, vi, u, v, VB_LATTICE_ARGS), e, ui, vi, VB_LATTICE_ARGS,
-                           indenters, t, grip VB_TRI_ARGS);
 }
 
 // Ends a stage: moves an element that ended inside an indenter or a torus tube back onto its
@@ -77,10 +74,12 @@ VB_INLINE void finish_stage(uint e, real4* un, real4* vn, global const uint* cel
 VB_INLINE void explicit_update(uint e, real4* ui, real4* vi, real4 f, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS,
                                real dt, int symplectic VB_TRI_PARAMS) {
   torus_grip grip = {0};  // friction of the indenters and tori (no-op without VB_FRICTION)
-  real4 a = acceleration_from(f, e, *ui, *vi, VB_LATTICE_ARGS, indenters, t_force, &grip VB_TRI_ARGS);
+  // the stage ends at u + dt·v + dt²·a (symplectic) or, through ṽ, at Heun's u' = u + dt·v + dt²/2·a
+  const real gain = (symplectic ? (real)1 : (real)0.5) * dt * dt;
+  real4 a = acceleration_from(f, e, *ui, *vi, VB_LATTICE_ARGS, indenters, t_force, dt, gain, &grip VB_TRI_ARGS);
 #if VB_TORI
   const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
-  torus_constrain_all(&a, X + xyz0(*ui), indenters, t_force, h, &grip);
+  torus_constrain_all(&a, X + xyz0(*ui), *vi, dt, gain, indenters, t_force, h, &grip);
 #endif
   if (symplectic) *vi += dt * a;
   if (symplectic) torus_apply_grip(vi, grip, dt);
@@ -95,10 +94,11 @@ VB_INLINE void explicit_update(uint e, real4* ui, real4* vi, real4 f, VB_LATTICE
 VB_INLINE real4 correct_update(uint e, real4* ui, real4 vi, real4 up, real4 vp, real4 f, VB_LATTICE_PARAMS,
                                VB_INDENTER_PARAMS, real dt VB_TRI_PARAMS) {
   torus_grip grip = {0};
-  real4 a = acceleration_from(f, e, up, vp, VB_LATTICE_ARGS, indenters, t_force, &grip VB_TRI_ARGS);
+  const real gain = (real)0.5 * dt * dt;  // as the predictor's
+  real4 a = acceleration_from(f, e, up, vp, VB_LATTICE_ARGS, indenters, t_force, dt, gain, &grip VB_TRI_ARGS);
 #if VB_TORI
   const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
-  torus_constrain_all(&a, X + xyz0(up), indenters, t_force, h, &grip);
+  torus_constrain_all(&a, X + xyz0(up), vp, dt, gain, indenters, t_force, h, &grip);
 #endif
   real4 vn = xyz0((vi + vp) * (real)0.5 + (real)0.5 * dt * a);
   torus_apply_grip(&vn, grip, (real)0.5 * dt);  // the predictor's half reaches vn through ṽ

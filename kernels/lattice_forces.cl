@@ -313,13 +313,18 @@ inline real indenter_distance(real4 x, global const real* ind, real t, real4* n_
 }
 
 // Contact of a touching element (within REAL_CONTACT_TOL·h of the surface). Push: unilateral,
-// the indenter carries the inward normal part of the element's force; with a friction
-// coefficient μ (column 17) it adds μ·|f_n| to the element's grip (device_contact.cl: Coulomb
-// friction at the velocity level, against the indenter's velocity). Slide: held on the surface,
-// the indenter carries the whole normal part (pull too), the element slides freely along it.
-// Stick: the element moves with the indenter, which carries all of its force.
+// the indenter carries the inward normal part of the element's force that would take it into the
+// indenter; with a friction coefficient μ (column 17) it adds μ·|f_n| to the element's grip
+// (device_contact.cl: Coulomb friction at the velocity level, against the indenter's velocity).
+// Slide: held on the surface, the indenter carries the whole normal part (pull too), the element
+// slides freely along it. Stick: the element moves with the indenter, which carries all of its force.
 // Returns the part carried (force on the indenter, N) and removes it from f.
-inline real4 contact_constrain(real4* f, real4 x, global const real* ind, real t, real h, torus_grip* grip) {
+// A push keeps the inward force that at most brings the element onto the surface by the stage's
+// end, near x + lead·v + reach·f (reach, m/N: the stage's gain on the acceleration over the
+// element's mass, fictitious under relaxation), as the torus device does (device_contact.cl,
+// torus_constrain: why); reach 0 (the check) carries all of it.
+inline real4 contact_constrain(real4* f, real4 x, real4 v, real lead, real reach, global const real* ind, real t, real h,
+                               torus_grip* grip) {
 #if VB_TRI_CONTACT
   if (ind[18] != 0) return (real4)(0);  // contact with the surface triangles (triangle_contact.cl)
 #endif
@@ -334,15 +339,22 @@ inline real4 contact_constrain(real4* f, real4 x, global const real* ind, real t
   }
   const real fn = dot3(*f, n);
   if (mode == 0 && fn >= 0) return (real4)(0);
-  *f -= fn * n;
+  real carried = fn;
+  if (mode == 0 && reach > 0) {
+    const real land = -(dist + lead * dot3(v - indenter_velocity(ind, t), n)) / reach;  // lands on the surface
+    carried = fn - fmin((real)0, fmax(fn, land));
+  }
+  *f -= carried * n;
 #if VB_FRICTION
-  if (mode == 0) grip_add(grip, fn, ind[17], n, indenter_velocity(ind, t));
+  if (mode == 0) grip_add(grip, carried, ind[17], n, indenter_velocity(ind, t));
 #endif
-  return fn * n;
+  return carried * n;
 }
 
-inline void contact_constrain_all(real4* f, real4 x, global const real* indenters, real t, real h, torus_grip* grip) {
-  for (int i = 0; i < VB_INDENTERS; ++i) contact_constrain(f, x, indenters + VB_IND_STRIDE * i, t, h, grip);
+inline void contact_constrain_all(real4* f, real4 x, real4 v, real lead, real reach, global const real* indenters,
+                                  real t, real h, torus_grip* grip) {
+  for (int i = 0; i < VB_INDENTERS; ++i)
+    contact_constrain(f, x, v, lead, reach, indenters + VB_IND_STRIDE * i, t, h, grip);
 }
 
 // Moves an element that ended inside an indenter back onto its surface; its normal velocity

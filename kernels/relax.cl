@@ -26,11 +26,14 @@ kernel void relax_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENT
     // m/m̃ turns it into f/m̃, then the fictitious damping.
     torus_grip grip = {0};  // on the acceleration, as in integrate.cl (the indenters' scaled here)
     const real4 f = less_lag(lattice_force(e, ui, vi, u, v, VB_LATTICE_ARGS), e, VB_LAG_KERNEL_ARGS);
-    real4 a = acceleration_from(f, e, ui, vi, VB_LATTICE_ARGS, indenters, t_force, &grip VB_TRI_ARGS) * relax_scale[e] -
-              c * xyz0(vi);
-    grip.grip_n *= relax_scale[e];
+    // The step ends at u + dt·v + dt²·a; the indenters see f/m, hence their gain carries the scale.
+    const real scale = relax_scale[e];
+    real4 a = acceleration_from(f, e, ui, vi, VB_LATTICE_ARGS, indenters, t_force, dt, dt * dt * scale,
+                                &grip VB_TRI_ARGS) * scale - c * xyz0(vi);
+    grip.grip_n *= scale;
 #if VB_TORI
-    torus_constrain_all(&a, rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui), indenters, t_force, h, &grip);
+    torus_constrain_all(&a, rest_position(cell_of[e], sy, sz, origin, h) + xyz0(ui), vi, dt, dt * dt, indenters, t_force,
+                        h, &grip);
 #endif
     vi = xyz0(vi + dt * a);
     torus_apply_grip(&vi, grip, dt);
