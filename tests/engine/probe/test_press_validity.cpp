@@ -15,7 +15,7 @@ namespace {
 
 constexpr double kH = 0.002;
 
-Scene block_over_inclusion(bool inclusion, double depth_m, int steps) {
+Scene block_over_inclusion(bool inclusion, double depth_m, int steps, double tolerance = 1e-5) {
   Scene s = test::probe_block(13, 13, 10, kH, 500);  // 26 × 26 × 20 mm
   s.model.shapes[0].label = "adipose";
   s.materials.clear();
@@ -30,7 +30,7 @@ Scene block_over_inclusion(bool inclusion, double depth_m, int steps) {
     s.materials["tumour"] = test::material("tumour", 10000, 1050);
   }
   s.solver.precision = Precision::Float;
-  s.stop.equilibrium = 1e-5;
+  s.stop.equilibrium = tolerance;
   IndenterSpec finger;
   finger.kind = IndenterSpec::Kind::Sphere;
   finger.radius_m = 0.008;
@@ -48,8 +48,10 @@ void print_press(const char* name, const PressResult& p) {
 double rise(const PressResult& p, std::size_t j) { return p.samples[j].press_force_n - p.samples[j - 1].press_force_n; }
 
 TEST(Probing, PressThatFoldsTheLatticeIsFlagged) {
-  const ProbeResult over = test::run_probe(block_over_inclusion(true, 2 * kH, 4));
-  const ProbeResult plain = test::run_probe(block_over_inclusion(false, 2 * kH, 4));
+  // Relaxed to 1e-6: near the fold the approach creeps, and at 1e-5 the H200's 3 mm press over the
+  // inclusion stopped on its way (det F 0.38, 13.0 mN, then 0.12, 11.5 mN; docs/PROBING.md).
+  const ProbeResult over = test::run_probe(block_over_inclusion(true, 2 * kH, 4, 1e-6));
+  const ProbeResult plain = test::run_probe(block_over_inclusion(false, 2 * kH, 4, 1e-6));
   const PressResult &a = over.presses.at(0), &b = plain.presses.at(0);
   print_press("over the inclusion", a);
   print_press("no inclusion", b);
