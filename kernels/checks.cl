@@ -154,7 +154,7 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_KERNEL
         if (uses_triangles(indenters + VB_IND_STRIDE * i)) continue;
 #endif
         torus_grip grip = {0};
-        real4 reaction = contact_constrain(&f, x, vi, 0, 0, indenters + VB_IND_STRIDE * i, t_force, h, &grip);
+        real4 reaction = contact_constrain(&f, x, (real4)(0), 0, 0, indenters + VB_IND_STRIDE * i, t_force, h, &grip);
 #if VB_FRICTION
         // Friction: kinetic μ·|f_n| for a sliding element, up to μ·|f_n| for one at rest (grip_n = μ·|f_n|).
         if (grip.grip_n > 0)

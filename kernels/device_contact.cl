@@ -37,6 +37,20 @@ VB_INLINE void grip_add(torus_grip* g, real push, real mu, real4 n, real4 surfac
 #endif
 }
 
+// The part of an inward normal force or acceleration fn (< 0) that a push contact carries, shared
+// by the torus device and the push indenters (lattice_forces.cl). In a stage the element, at
+// distance dist outside the surface and moving at vn along n relative to it, ends near
+// dist + lead·vn + gain·(fn − carried): it keeps what brings it at most onto the surface, and the
+// contact carries the rest. Without that rule, an element whose free equilibrium lay inside the
+// contact band coasted out to the band's edge with its restoring force removed and fell back, a
+// cycle that never settled (docs/PHYSICS.md, "Indenters", landing rule). gain 0 (a check, after
+// which no stage follows): the contact carries all of fn.
+VB_INLINE real push_carried(real fn, real dist, real vn, real lead, real gain) {
+  if (!(gain > 0)) return fn;
+  const real land = -(dist + lead * vn) / gain;  // lands on the surface at the stage's end
+  return fn - fmin((real)0, fmax(fn, land));
+}
+
 // At a check: the tangential part of f (to n) that friction holds, at most mu·fn (fn ≥ 0, the
 // compressive normal force); removed from f and returned (the contact carries it).
 VB_INLINE real4 friction_hold(real4* f, real4 n, real fn, real mu) {
@@ -118,13 +132,9 @@ VB_INLINE real torus_distance(real4 x, global const real* table, global const re
 
 // Frictionless unilateral contact of an element within REAL_CONTACT_TOL·h of the tube surface (or
 // inside): the torus carries the inward normal part of f (a force, or the acceleration f/m: the
-// same constraint) that would take the element into the tube, which is removed from f and returned
-// (the force on the torus, N, for a force). With friction, μ·|f_n| is added to the grip.
-// In a stage the element (at x, velocity v) ends near x + lead·v + gain·a, so an element still
-// off the surface keeps the inward acceleration that at most brings it onto the surface: without
-// that, one whose free equilibrium lies inside the band coasted out to the band's edge with its
-// restoring force removed and fell back, a cycle that never settled (docs/PHYSICS.md, "Indenters",
-// landing rule). gain 0 (the check): the torus carries the whole inward part within the band.
+// same constraint) that would take the element into the tube (push_carried: the element at x with
+// velocity v ends its stage near x + lead·v + gain·a), which is removed from f and returned (the
+// force on the torus, N, for a force). With friction, μ·|f_n| is added to the grip.
 VB_INLINE real4 torus_constrain(real4* f, real4 x, real4 v, real lead, real gain, global const real* table,
                                 global const real* tor, real t, real h, torus_grip* grip) {
   const real4 rad = torus_radii(table, tor, t);
@@ -132,9 +142,8 @@ VB_INLINE real4 torus_constrain(real4* f, real4 x, real4 v, real lead, real gain
   real4 n, w;
   const real dist = torus_distance_at(x, tor, rad, &n, &w);
   const real fn = dot3(*f, n);
-  const real land = gain > 0 ? -(dist + lead * dot3(v - w, n)) / gain : (real)0;  // lands on the surface
-  const real keep = fmin((real)0, fmax(fn, land));
-  const real push = dist <= REAL_CONTACT_TOL * h && fn < 0 ? fn - keep : (real)0;  // ≤ 0
+  const real push =
+      dist <= REAL_CONTACT_TOL * h && fn < 0 ? push_carried(fn, dist, dot3(v - w, n), lead, gain) : (real)0;  // ≤ 0
   *f -= push * n;
   grip_add(grip, push, tor[3], n, w);
   return push * n;

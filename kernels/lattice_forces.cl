@@ -319,10 +319,10 @@ inline real indenter_distance(real4 x, global const real* ind, real t, real4* n_
 // Slide: held on the surface, the indenter carries the whole normal part (pull too), the element
 // slides freely along it. Stick: the element moves with the indenter, which carries all of its force.
 // Returns the part carried (force on the indenter, N) and removes it from f.
-// A push keeps the inward force that at most brings the element onto the surface by the stage's
-// end, near x + lead·v + reach·f (reach, m/N: the stage's gain on the acceleration over the
-// element's mass, fictitious under relaxation), as the torus device does (device_contact.cl,
-// torus_constrain: why); reach 0 (the check) carries all of it.
+// A push carries only what would take the element through the surface within the stage, which
+// ends near x + lead·v + reach·f (reach, m/N: the stage's gain on the acceleration over the
+// element's mass, fictitious under relaxation; device_contact.cl, push_carried); reach 0 (the
+// check) carries all of it.
 inline real4 contact_constrain(real4* f, real4 x, real4 v, real lead, real reach, global const real* ind, real t, real h,
                                torus_grip* grip) {
 #if VB_TRI_CONTACT
@@ -339,11 +339,7 @@ inline real4 contact_constrain(real4* f, real4 x, real4 v, real lead, real reach
   }
   const real fn = dot3(*f, n);
   if (mode == 0 && fn >= 0) return (real4)(0);
-  real carried = fn;
-  if (mode == 0 && reach > 0) {
-    const real land = -(dist + lead * dot3(v - indenter_velocity(ind, t), n)) / reach;  // lands on the surface
-    carried = fn - fmin((real)0, fmax(fn, land));
-  }
+  const real carried = mode == 0 ? push_carried(fn, dist, dot3(v - indenter_velocity(ind, t), n), lead, reach) : fn;
   *f -= carried * n;
 #if VB_FRICTION
   if (mode == 0) grip_add(grip, carried, ind[17], n, indenter_velocity(ind, t));
