@@ -70,6 +70,7 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
   SimulationReport report;
   report.summary = result.summary;
   report.warnings = model.warnings;
+  if (auto hint = float_floor_hint(scene, result.summary)) report.warnings.push_back(*hint);
   if (reference && !reference->converged) {
     char text[200];
     std::snprintf(text, sizeof text,

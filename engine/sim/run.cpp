@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "engine/device/torus.hpp"
@@ -120,6 +121,24 @@ bool at_equilibrium(const Simulator& sim, const StateCheck& c, const Equilibrium
   // (docs/BENCHMARKS.md).
   if (sim.relaxing()) return c.max_speed_m_s / std::sqrt(sim.relaxation_omega_sq()) <= tol * scales.size_m;
   return c.max_speed_m_s <= tol * scales.wave_speed_m_s;
+}
+
+std::optional<std::string> float_floor_hint(const Scene& scene, const RunSummary& s) {
+  // Float resolves a residual to ~4e-7 of F_ref (docs/VALIDATION.md, "Float equilibrium floor"),
+  // so a tolerance within a few times of it is where round-off, not dynamics, can hold a run.
+  constexpr double kFloatFloorTolerance = 3e-6;
+  const double tol = scene.stop.equilibrium;
+  if (s.converged || s.stop_reason != "max_steps" || scene.solver.precision != Precision::Float ||
+      scene.solver.integrator == Integrator::Relaxation || !(tol > 0) || tol > kFloatFloorTolerance ||
+      s.final_residual > tol || !(s.final_speed_ratio > tol))
+    return std::nullopt;
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "stopped at stop.max_steps with its residual met (%.2g) but its speed at %.2g of the wave speed "
+                "(tolerance %.2g): float's round-off can keep speeds above it (contact elements do); set solver.precision = "
+                "\"double\", loosen stop.equilibrium, or use solver.integrator = \"relaxation\"",
+                s.final_residual, s.final_speed_ratio, tol);
+  return std::string(text);
 }
 
 std::size_t nearest_element(const Lattice& lattice, const Vec3& p) {
