@@ -7,6 +7,7 @@
 
 #include "engine/error.hpp"
 #include "engine/material/linear_spring.hpp"
+#include "engine/sim/parallel_chunks.hpp"
 #include "engine/sim/triangle_contact.hpp"
 
 namespace vb {
@@ -68,23 +69,32 @@ Rows element_rows(const Lattice& lattice, const ElementArrays& el, double dashpo
 
 StabilityBounds stability_bounds(const Lattice& lattice, const ElementArrays& el, double dashpot_ratio,
                                  double global_damping, const std::vector<double>& extra_row_n_m) {
-  StabilityBounds b;
+  const std::size_t n = lattice.element_count(), chunks = chunk_count(n);
+  std::vector<Rows> most(chunks);  // each chunk's largest bounds: max is exact in any order
+  for_chunks(n, chunks, [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+    Rows& m = most[chunk];
+    for (std::size_t e = begin; e < end; ++e) {
+      if (el.inverse_mass[e] == 0) continue;
+      const Rows r = element_rows(lattice, el, dashpot_ratio, e, extra_row_n_m.empty() ? 0.0 : extra_row_n_m[e]);
+      m.omega_sq = std::max(m.omega_sq, r.omega_sq);
+      m.c_max = std::max(m.c_max, r.c_max);
+    }
+  });
   double omega_sq = 0, c_max = 0;
-  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
-    if (el.inverse_mass[e] == 0) continue;
-    const Rows r = element_rows(lattice, el, dashpot_ratio, e, extra_row_n_m.empty() ? 0.0 : extra_row_n_m[e]);
-    omega_sq = std::max(omega_sq, r.omega_sq);
-    c_max = std::max(c_max, r.c_max);
-  }
+  for (const Rows& m : most) omega_sq = std::max(omega_sq, m.omega_sq), c_max = std::max(c_max, m.c_max);
+  StabilityBounds b;
   b.omega_max = std::sqrt(omega_sq);
   b.damping_max = c_max + global_damping;
   return b;
 }
 
 std::vector<double> element_row_stiffness_n_m(const Lattice& lattice, const ElementArrays& el) {
-  std::vector<double> k(lattice.element_count(), 0.0);
-  for (std::size_t e = 0; e < lattice.element_count(); ++e)
-    if (el.inverse_mass[e] != 0) k[e] = element_rows(lattice, el, 0, e).k_max;
+  const std::size_t n = lattice.element_count();
+  std::vector<double> k(n, 0.0);
+  for_chunks(n, chunk_count(n), [&](std::size_t, std::size_t begin, std::size_t end) {
+    for (std::size_t e = begin; e < end; ++e)
+      if (el.inverse_mass[e] != 0) k[e] = element_rows(lattice, el, 0, e).k_max;
+  });
   return k;
 }
 

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 #include "engine/error.hpp"
+#include "engine/sim/parallel_chunks.hpp"
 #include "engine/sim/time_step.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
 
@@ -74,6 +77,51 @@ TEST(TimeStep, RelaxationBoundsAndMassScaleComeFromOneWalk) {
   s.solver.integrator = Integrator::Heun;
   s.solver.dashpot_ratio = 0.1;
   EXPECT_TRUE(choose_time_step(s, m.lattice, m.elements).row_stiffness_n_m.empty());
+}
+
+// Every index of [0, n) is visited once whatever the split, including more chunks than indices.
+TEST(ParallelChunks, CoverEachIndexOnce) {
+  for (const std::size_t n : {0u, 1u, 5u, 1000u, 65537u})
+    for (const std::size_t chunks : {1u, 2u, 3u, 7u, 16u}) {
+      std::vector<std::atomic<int>> seen(n);
+      std::vector<int> chunk_of(n, -1);
+      for_chunks(n, chunks, [&](std::size_t c, std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) ++seen[i], chunk_of[i] = int(c);
+      });
+      for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(seen[i].load(), 1) << "n " << n << ", chunks " << chunks << ", index " << i;
+      EXPECT_TRUE(std::is_sorted(chunk_of.begin(), chunk_of.end())) << "chunks are contiguous, in order";
+    }
+  EXPECT_EQ(chunk_count(1000), 1u);  // too short to split
+  EXPECT_LE(chunk_count(1u << 24), std::max(1u, std::thread::hardware_concurrency()));
+}
+
+// The walks over a model large enough to split (38,400 elements: two chunks or more on a 2-core
+// machine): every element's row is computed (the interior's all equal, the faces' smaller, none
+// left at zero), and the bound's walk agrees with the rows' walk on their largest.
+TEST(TimeStep, WalksSplitOverCoresComputeEveryElementsRow) {
+  const Scene s = test::box_scene(40, 40, 24, 0.002);
+  const auto m = test::make_model(s);
+  const std::size_t n = m.lattice.element_count();
+  ASSERT_EQ(n, 38400u);
+  ASSERT_GE(chunk_count(n), std::min(2u, std::max(1u, std::thread::hardware_concurrency())));
+  const std::vector<double> k = element_row_stiffness_n_m(m.lattice, m.elements);
+  ASSERT_EQ(k.size(), n);
+  double interior = 0, most = 0;
+  std::size_t interior_count = 0;
+  for (std::size_t e = 0; e < n; ++e) {
+    ASSERT_GT(k[e], 0.0) << "element " << e << " left out";
+    most = std::max(most, k[e] * m.elements.inverse_mass[e]);
+    const auto ijk = m.lattice.voxel_ijk(e);
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) inside = inside && ijk[a] > 0 && ijk[a] + 1 < m.lattice.dims[a];
+    if (!inside) continue;
+    if (interior == 0) interior = k[e];
+    EXPECT_EQ(k[e], interior) << e;
+    ++interior_count;
+  }
+  EXPECT_EQ(interior_count, 38u * 38u * 22u);
+  for (std::size_t e = 0; e < n; ++e) EXPECT_LE(k[e], interior) << e;
+  EXPECT_EQ(stability_bounds(m.lattice, m.elements, 0, 0).omega_max, std::sqrt(most));
 }
 
 }  // namespace
