@@ -5,7 +5,9 @@
 /// depend on the split: per-element outputs, or reductions (max) that are exact in any order.
 #include <algorithm>
 #include <cstddef>
+#include <system_error>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace vb {
@@ -19,13 +21,21 @@ inline std::size_t chunk_count(std::size_t n, std::size_t min_per_chunk = 4096) 
 }
 
 /// Calls fn(chunk, begin, end) for `chunks` contiguous ranges covering [0, n), chunk 0 on this
-/// thread and the others on their own. fn must not throw.
+/// thread and the others on their own (on this one too where the system has no thread to give).
+/// fn must not throw.
 template <class Fn>
 void for_chunks(std::size_t n, std::size_t chunks, Fn fn) {
+  chunks = std::max<std::size_t>(1, chunks);
   auto range = [&](std::size_t c) { return std::pair{n * c / chunks, n * (c + 1) / chunks}; };
   std::vector<std::thread> threads;
   threads.reserve(chunks - 1);
-  for (std::size_t c = 1; c < chunks; ++c) threads.emplace_back([&, c] { fn(c, range(c).first, range(c).second); });
+  for (std::size_t c = 1; c < chunks; ++c) {
+    try {
+      threads.emplace_back([&, c] { fn(c, range(c).first, range(c).second); });
+    } catch (const std::system_error&) {
+      fn(c, range(c).first, range(c).second);
+    }
+  }
   fn(std::size_t(0), range(0).first, range(0).second);
   for (std::thread& t : threads) t.join();
 }
