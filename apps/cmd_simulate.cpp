@@ -46,10 +46,10 @@ int run_simulate(const SimulateOptions& o) {
   options.on_perturbed_run = [&](const PerturbedRun& r) {
     if (o.quiet) return;
     bar.finish();
-    std::fprintf(stderr, "voxbreast: posture %d/%d %s device (roll %.2f, pitch %.2f, yaw %.2f deg): tumour at (%.2f, %.2f, %.2f) mm\n",
+    std::fprintf(stderr, "voxbreast: posture %d/%d %s device (roll %.2f, pitch %.2f, yaw %.2f deg): tumour at (%.2f, %.2f, %.2f) mm%s\n",
                  r.index, scene.reproducibility.perturbations, r.device ? "with" : "without", r.rpy_deg.x(),
                  r.rpy_deg.y(), r.rpy_deg.z(), 1e3 * r.tumour_centroid_m.x(), 1e3 * r.tumour_centroid_m.y(),
-                 1e3 * r.tumour_centroid_m.z());
+                 1e3 * r.tumour_centroid_m.z(), r.converged ? "" : ", stopped before equilibrium");
   };
   const SimulationReport report = simulate_scene(scene, cl, o.out, options);
   bar.finish();

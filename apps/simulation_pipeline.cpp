@@ -88,6 +88,8 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
     summary["reference_state"] = reference_state_to_json(*reference, scene.reference_state);
   }
   report.positioning.reproducibility = repro;
+  if (repro)
+    if (auto unsettled = unsettled_runs_warning(*repro)) report.warnings.push_back(*unsettled);
   summary["positioning"] = positioning_to_json(report.positioning);
   if (repro) summary["positioning"]["reproducibility"] = reproducibility_to_json(*repro, scene.reproducibility);
   write_metrics_csv(out_dir + "/metrics.csv", result.summary, report.positioning);

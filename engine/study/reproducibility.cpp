@@ -35,6 +35,21 @@ TumourSpread tumour_spread(const std::vector<Vec3>& p) {
   return s;
 }
 
+std::optional<std::string> unsettled_runs_warning(const ReproducibilityResult& r) {
+  std::string names;
+  int unsettled = 0;
+  for (const PerturbedRun& run : r.runs) {
+    if (run.converged) continue;
+    names += std::string(unsettled++ ? ", " : "") + "posture " + std::to_string(run.index) +
+             (run.device ? " with the device" : " without it");
+  }
+  if (unsettled == 0) return std::nullopt;
+  return std::to_string(unsettled) + " of " + std::to_string(r.runs.size()) +
+         " perturbed runs stopped before equilibrium (" + names +
+         "), and the tumour spreads count them where they stopped: raise stop.max_steps, or see the "
+         "converged column of reproducibility.csv";
+}
+
 ReproducibilityResult run_reproducibility(const Scene& scene, const Lattice& lattice, const ClContext& cl,
                                           const std::vector<double>* rest_offsets_m,
                                           const std::function<void(const PerturbedRun&)>& on_run) {

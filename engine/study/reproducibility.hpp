@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "engine/sim/opencl_runtime.hpp"
@@ -44,6 +45,10 @@ struct ReproducibilityResult {
 
 /// The spread of a set of centroids (none: all zero).
 TumourSpread tumour_spread(const std::vector<Vec3>& centroids_m);
+
+/// A warning naming the runs that stopped without equilibrium, whose centroids the spreads still
+/// count, or nothing when every run settled.
+std::optional<std::string> unsettled_runs_warning(const ReproducibilityResult& result);
 
 /// Runs the perturbations on `cl`: each is the scene's run from the CT (same integrator, stop
 /// rule and, when given, the same unloaded rest offsets) with the chest-wall anchor turned.

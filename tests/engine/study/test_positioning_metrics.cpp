@@ -5,6 +5,7 @@
 #include "engine/error.hpp"
 #include "engine/lattice/voxelise.hpp"
 #include "engine/study/positioning_metrics.hpp"
+#include "engine/study/reproducibility.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
 
 namespace vb {
@@ -149,6 +150,27 @@ TEST(Reproducibility, SpreadIsTheRmsAndLargestDistanceFromTheMean) {
   EXPECT_NEAR(s.std_m, std::sqrt(2.5), 1e-15);  // mean of 1, 1, 4, 4
   EXPECT_DOUBLE_EQ(s.max_m, 2.0);
   EXPECT_EQ(tumour_spread({}).runs, 0);
+}
+
+// A posture run that stopped at max_steps is kept in the spread and named in a warning.
+TEST(Reproducibility, RunsThatStoppedBeforeEquilibriumAreNamed) {
+  ReproducibilityResult r;
+  for (int k = 1; k <= 3; ++k)
+    for (const bool device : {true, false}) {
+      PerturbedRun run;
+      run.index = k;
+      run.device = device;
+      run.converged = true;
+      r.runs.push_back(run);
+    }
+  EXPECT_FALSE(unsettled_runs_warning(r)) << "every run settled";
+  r.runs[2].converged = false;  // posture 2 with the device
+  r.runs[5].converged = false;  // posture 3 without it
+  const auto w = unsettled_runs_warning(r);
+  ASSERT_TRUE(w.has_value());
+  EXPECT_EQ(w->rfind("2 of 6 perturbed runs stopped before equilibrium", 0), 0u) << *w;
+  EXPECT_NE(w->find("posture 2 with the device, posture 3 without it"), std::string::npos) << *w;
+  EXPECT_NE(w->find("stop.max_steps"), std::string::npos) << *w;
 }
 
 }  // namespace
