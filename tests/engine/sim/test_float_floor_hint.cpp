@@ -26,10 +26,16 @@ Scene float_heun_scene(double tol) {
 }
 
 TEST(FloatFloorHint, NamesDoublePrecisionWhenOnlyTheSpeedMissedATightTolerance) {
-  const auto hint = float_floor_hint(float_heun_scene(1e-6), ring_run_at_max_steps());
+  Scene ring = float_heun_scene(1e-6);
+  ring.tori.emplace_back();
+  const auto hint = float_floor_hint(ring, ring_run_at_max_steps());
   ASSERT_TRUE(hint.has_value());
   EXPECT_NE(hint->find("solver.precision = \"double\""), std::string::npos) << *hint;
   EXPECT_NE(hint->find("1.5e-06"), std::string::npos) << *hint;  // the speed it stopped at
+  EXPECT_NE(hint->find("in contact"), std::string::npos) << *hint;
+  const auto no_contact = float_floor_hint(float_heun_scene(1e-6), ring_run_at_max_steps());
+  ASSERT_TRUE(no_contact.has_value());
+  EXPECT_EQ(no_contact->find("contact"), std::string::npos) << "a scene without contact: " << *no_contact;
 }
 
 TEST(FloatFloorHint, SaysNothingWhereRoundOffIsNotTheReason) {
