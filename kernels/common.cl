@@ -77,6 +77,21 @@ inline real4 rest_position(uint cell, int sy, int sz, real4 origin, real h) {
 // An element within this fraction of a spacing of the indenter surface is in contact.
 #define REAL_CONTACT_TOL ((real)1e-3)
 
+#if VB_DOUBLE
+#define VB_EPSILON DBL_EPSILON
+#else
+#define VB_EPSILON FLT_EPSILON
+#endif
+
+// The smallest distance from a contact surface (m) that this precision tells from zero at x (lattice
+// frame): x = X + u is rounded to half a spacing of its largest coordinate, so a distance computed
+// from it steps by about that as u changes. A push contact takes a distance within this of zero as
+// zero: chasing it made float elements on a surface move by a spacing per step for ever, a speed
+// floor above 10⁻⁶ of the wave speed (docs/PHYSICS.md, "Float equilibrium floor").
+inline real contact_resolution(real4 x) {
+  return (real)4 * VB_EPSILON * fmax(fmax(fabs(x.x), fabs(x.y)), fabs(x.z));
+}
+
 // Parameters of the force and stepping helpers, in this order; kernels take
 // VB_LATTICE_KERNEL_PARAMS (below, set by the host in one place) and name these with
 // VB_UNPACK_LATTICE.

@@ -43,11 +43,13 @@ VB_INLINE void grip_add(torus_grip* g, real push, real mu, real4 n, real4 surfac
 // dist + lead·vn + gain·(fn − carried): it keeps what brings it at most onto the surface, and the
 // contact carries the rest. Without that rule, an element whose free equilibrium lay inside the
 // contact band coasted out to the band's edge with its restoring force removed and fell back, a
-// cycle that never settled (docs/PHYSICS.md, "Indenters", landing rule). gain 0 (a check, after
-// which no stage follows): the contact carries all of fn.
-VB_INLINE real push_carried(real fn, real dist, real vn, real lead, real gain) {
+// cycle that never settled (docs/PHYSICS.md, "Indenters", landing rule). A distance within `res`
+// (contact_resolution) of zero counts as on the surface: the stage then only stops the normal
+// motion. gain 0 (a check, after which no stage follows): the contact carries all of fn.
+VB_INLINE real push_carried(real fn, real dist, real vn, real lead, real gain, real res) {
   if (!(gain > 0)) return fn;
-  const real land = -(dist + lead * vn) / gain;  // lands on the surface at the stage's end
+  const real off = fabs(dist) <= res ? (real)0 : dist;
+  const real land = -(off + lead * vn) / gain;  // lands on the surface at the stage's end
   return fn - fmin((real)0, fmax(fn, land));
 }
 
@@ -143,7 +145,8 @@ VB_INLINE real4 torus_constrain(real4* f, real4 x, real4 v, real lead, real gain
   const real dist = torus_distance_at(x, tor, rad, &n, &w);
   const real fn = dot3(*f, n);
   const real push =
-      dist <= REAL_CONTACT_TOL * h && fn < 0 ? push_carried(fn, dist, dot3(v - w, n), lead, gain) : (real)0;  // ≤ 0
+      dist <= REAL_CONTACT_TOL * h && fn < 0 ? push_carried(fn, dist, dot3(v - w, n), lead, gain, contact_resolution(x))
+                                             : (real)0;  // ≤ 0
   *f -= push * n;
   grip_add(grip, push, tor[3], n, w);
   return push * n;
@@ -154,8 +157,9 @@ VB_INLINE void torus_constrain_all(real4* f, real4 x, real4 v, real lead, real g
   for (int i = 0; i < VB_TORI; ++i) torus_constrain(f, x, v, lead, gain, table, torus_row(table, i), t, h, grip);
 }
 
-// Moves an element that ended a stage inside a tube back onto its surface; its normal velocity
-// becomes at least the surface's (an inflating tube pushes it out at dr/dt).
+// Moves an element that ended a stage inside a tube (deeper than contact_resolution) back onto its
+// surface; its normal velocity becomes at least the surface's (an inflating tube pushes it out at
+// dr/dt).
 VB_INLINE void torus_project_all(real4* ui, real4* vi, real4 X, global const real* table, real t, real h) {
   for (int i = 0; i < VB_TORI; ++i) {
     global const real* tor = torus_row(table, i);
@@ -163,9 +167,10 @@ VB_INLINE void torus_project_all(real4* ui, real4* vi, real4 X, global const rea
     if (!torus_near(x, tor, rad, REAL_CONTACT_TOL * h)) continue;
     real4 n, w;
     const real dist = torus_distance_at(x, tor, rad, &n, &w);
-    *ui -= fmin(dist, (real)0) * n;
+    const int inside = dist < -contact_resolution(x);
+    *ui -= (inside ? dist : (real)0) * n;
     const real vn = dot3(*vi, n), wn = dot3(w, n);
-    *vi += (dist < 0 && vn < wn ? wn - vn : (real)0) * n;
+    *vi += (inside && vn < wn ? wn - vn : (real)0) * n;
   }
 }
 #endif

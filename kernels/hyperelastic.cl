@@ -187,12 +187,6 @@ inline mat3 stress_invariants(mat3 C, real J, real c10, real c01) {
   return S;
 }
 
-#if VB_DOUBLE
-#define VB_EPSILON DBL_EPSILON
-#else
-#define VB_EPSILON FLT_EPSILON
-#endif
-
 // Cyclic Jacobi eigen-decomposition of symmetric C: C = V·diag(w)·Vᵀ (robust when eigenvalues
 // coincide, as at rest). An off-diagonal entry below rounding of its diagonal pair is not
 // rotated (the rotation would change the result by rounding only), and the sweeps stop once a

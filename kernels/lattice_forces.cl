@@ -339,7 +339,8 @@ inline real4 contact_constrain(real4* f, real4 x, real4 v, real lead, real reach
   }
   const real fn = dot3(*f, n);
   if (mode == 0 && fn >= 0) return (real4)(0);
-  const real carried = mode == 0 ? push_carried(fn, dist, dot3(v - indenter_velocity(ind, t), n), lead, reach) : fn;
+  const real carried =
+      mode == 0 ? push_carried(fn, dist, dot3(v - indenter_velocity(ind, t), n), lead, reach, contact_resolution(x)) : fn;
   *f -= carried * n;
 #if VB_FRICTION
   if (mode == 0) grip_add(grip, carried, ind[17], n, indenter_velocity(ind, t));
@@ -353,10 +354,10 @@ inline void contact_constrain_all(real4* f, real4 x, real4 v, real lead, real re
     contact_constrain(f, x, v, lead, reach, indenters + VB_IND_STRIDE * i, t, h, grip);
 }
 
-// Moves an element that ended inside an indenter back onto its surface; its normal velocity
-// becomes at least the indenter's (push). A held element (slide, stick: within the contact
-// tolerance) is put back on the surface and takes the indenter's normal velocity (slide) or its
-// whole velocity (stick).
+// Moves an element that ended inside an indenter (deeper than contact_resolution) back onto its
+// surface; its normal velocity becomes at least the indenter's (push). A held element (slide,
+// stick: within the contact tolerance) is put back on the surface and takes the indenter's normal
+// velocity (slide) or its whole velocity (stick).
 inline void contact_project_all(real4* ui, real4* vi, real4 X, global const real* indenters, real t, real h) {
   for (int i = 0; i < VB_INDENTERS; ++i) {
     global const real* ind = indenters + VB_IND_STRIDE * i;
@@ -365,8 +366,9 @@ inline void contact_project_all(real4* ui, real4* vi, real4 X, global const real
     if (ind[18] != 0) continue;  // triangle contact: a force, not a projection
 #endif
     real4 n;
-    const real dist = indenter_distance(X + xyz0(*ui), ind, t, &n);
-    if (mode == 0 ? dist >= 0 : fabs(dist) > REAL_CONTACT_TOL * h) continue;
+    const real4 x = X + xyz0(*ui);
+    const real dist = indenter_distance(x, ind, t, &n);
+    if (mode == 0 ? dist >= -contact_resolution(x) : fabs(dist) > REAL_CONTACT_TOL * h) continue;
     *ui -= dist * n;
     const real4 w = indenter_velocity(ind, t);
     const real vn = dot3(*vi, n), wn = dot3(w, n);

@@ -132,13 +132,12 @@ std::optional<std::string> float_floor_hint(const Scene& scene, const RunSummary
       scene.solver.integrator == Integrator::Relaxation || !(tol > 0) || tol > kFloatFloorTolerance ||
       s.final_residual > tol || !(s.final_speed_ratio > tol))
     return std::nullopt;
-  const bool contact = !scene.tori.empty() || !scene.indenters.empty();
-  char text[340];
+  char text[320];
   std::snprintf(text, sizeof text,
                 "stopped at stop.max_steps with its residual met (%.2g) but its speed at %.2g of the wave speed "
-                "(tolerance %.2g): float's round-off can keep speeds above it%s; set solver.precision = "
+                "(tolerance %.2g): float's round-off can keep speeds above it; set solver.precision = "
                 "\"double\", loosen stop.equilibrium, or use solver.integrator = \"relaxation\"",
-                s.final_residual, s.final_speed_ratio, tol, contact ? " (elements in contact do)" : "");
+                s.final_residual, s.final_speed_ratio, tol);
   return std::string(text);
 }
 

@@ -44,11 +44,11 @@ EquilibriumScales equilibrium_scales(const Lattice& lattice, const ElementArrays
 bool at_equilibrium(const Simulator& sim, const StateCheck& c, const EquilibriumScales& scales, double tol);
 
 /// Why a dynamic float run may have stopped short of the criterion, or nothing: its residual met
-/// the tolerance and its speed did not, at a tolerance near float's round-off. There, contact
-/// elements keep speeds of a few position quanta per step (the obstacle's surface is resolved to
-/// float's spacing at its own size, ~10⁻⁹ m for a 1 cm tube; docs/VALIDATION.md, "Contact inside
-/// the band"), so only double precision settles (the phantom's tightest ring at 10⁻⁶: double in
-/// 2,700 steps, float not in 60,000, the two within 0.022 µm).
+/// the tolerance and its speed did not, at a tolerance near float's round-off (the residual's floor
+/// is ~4·10⁻⁷), where round-off rather than dynamics can keep a speed up. Contact did, until push
+/// contact took distances within float's resolution as zero (docs/VALIDATION.md, "Contact inside
+/// the band": the phantom's tightest ring at 10⁻⁶ ran float to max_steps 60,000; it now settles
+/// in 2,700 steps, as double does).
 std::optional<std::string> float_floor_hint(const Scene& scene, const RunSummary& summary);
 
 /// Element nearest to a world point (m).

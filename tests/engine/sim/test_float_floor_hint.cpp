@@ -5,9 +5,9 @@
 namespace vb {
 namespace {
 
-// The phantom's tightest ring at 1e-6 (docs/VALIDATION.md, "Contact inside the band"): Heun in
-// float stopped at max_steps 60,000 with its residual at 2.3e-7 and its speed at 1.46e-6 of the
-// wave speed; double settled in 2,700 steps.
+// What the phantom's tightest ring at 1e-6 gave before push contact took distances within float's
+// resolution as zero (docs/VALIDATION.md, "Contact inside the band"): Heun in float stopped at
+// max_steps 60,000 with its residual at 2.3e-7 and its speed at 1.46e-6 of the wave speed.
 RunSummary ring_run_at_max_steps() {
   RunSummary s;
   s.converged = false;
@@ -26,16 +26,10 @@ Scene float_heun_scene(double tol) {
 }
 
 TEST(FloatFloorHint, NamesDoublePrecisionWhenOnlyTheSpeedMissedATightTolerance) {
-  Scene ring = float_heun_scene(1e-6);
-  ring.tori.emplace_back();
-  const auto hint = float_floor_hint(ring, ring_run_at_max_steps());
+  const auto hint = float_floor_hint(float_heun_scene(1e-6), ring_run_at_max_steps());
   ASSERT_TRUE(hint.has_value());
   EXPECT_NE(hint->find("solver.precision = \"double\""), std::string::npos) << *hint;
   EXPECT_NE(hint->find("1.5e-06"), std::string::npos) << *hint;  // the speed it stopped at
-  EXPECT_NE(hint->find("in contact"), std::string::npos) << *hint;
-  const auto no_contact = float_floor_hint(float_heun_scene(1e-6), ring_run_at_max_steps());
-  ASSERT_TRUE(no_contact.has_value());
-  EXPECT_EQ(no_contact->find("contact"), std::string::npos) << "a scene without contact: " << *no_contact;
 }
 
 TEST(FloatFloorHint, SaysNothingWhereRoundOffIsNotTheReason) {
