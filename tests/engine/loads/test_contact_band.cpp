@@ -162,9 +162,10 @@ TEST_P(FloatRest, ElementsOnAnObstacleFarFromTheOriginSettleInFloat) {
   ASSERT_TRUE(f.summary.converged) << f.summary.stop_reason << ", speed " << f.summary.final_speed_ratio;
   // The obstacle presses (1 mN: thirteen times one element's weight, 78 µN).
   EXPECT_GT(carried.norm(), 1e-3);
-  // Float's contact resolution there, 4·2⁻²³·0.5 m = 0.24 µm, bounds how far a resting element may
-  // stop from double's.
-  EXPECT_LT(worst, 0.24e-6);
+  // A resting element stops within float's contact resolution there, ρ = 4·2⁻²³·0.5 m = 0.24 µm,
+  // of the surface, which x's own rounding (a spacing, ρ/4) places: within 1.25·ρ of double's
+  // (PoCL 0.10 µm, the H200 0.23 µm over the sphere).
+  EXPECT_LT(worst, 1.25 * 0.24e-6);
 }
 
 INSTANTIATE_TEST_SUITE_P(Obstacles, FloatRest, ::testing::Values(Obstacle::Torus, Obstacle::Sphere),
