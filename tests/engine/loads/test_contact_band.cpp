@@ -101,7 +101,8 @@ INSTANTIATE_TEST_SUITE_P(Obstacles, ContactBand,
 /// (its corner at `offset`), hanging from its held top layer under gravity, with an obstacle under
 /// its bottom elements (1 mm above the face) rising 1 mm over 0.1 s, from 0.5 mm under them to
 /// 0.5 mm into them, and then held: the bottom elements over it end at rest on its surface. The
-/// sphere: radius 20 mm (a dozen elements rest on it); the torus: R = 4 mm, axis z, its tube inflating from r = 2 to 3 mm.
+/// sphere: radius 20 mm (a dozen elements rest on it); the torus: R = 4 mm, axis z, its tube
+/// inflating from r = 2 to 3 mm.
 RunOutput rest_on(Obstacle obstacle, Precision precision, const Vec3& offset) {
   Scene s = test::box_scene(5, 5, 4, h, 3000);
   s.model.shapes[0].min_m += offset;
