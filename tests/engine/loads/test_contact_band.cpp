@@ -10,8 +10,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <tuple>
+#include <utility>
 
 #include "engine/sim/run.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
@@ -24,6 +26,37 @@ constexpr double kGap = 0.5e-3 * h;  // under the free equilibrium: half the ban
 
 enum class Obstacle { Torus, Sphere };
 
+/// A block of nx × ny × nz elements (spacing h) with its corner at `corner`, its top layer held,
+/// under gravity along −z.
+Scene hanging_block(int nx, int ny, int nz, const Vec3& corner) {
+  Scene s = test::box_scene(nx, ny, nz, h, 3000);
+  s.model.shapes[0].min_m += corner;
+  s.model.shapes[0].max_m += corner;
+  s.anchors.push_back(test::halfspace_anchor("top", corner + Vec3(0, 0, (nz - 1) * h), Vec3::UnitZ()));
+  s.gravity.active = true;
+  s.gravity.acceleration_m_s2 = Vec3(0, 0, -g);
+  return s;
+}
+
+struct Settled {
+  test::Model model;
+  RunOutput out;
+};
+
+/// Runs s to `tol` or `max_steps` with the damping both fixtures use (30/s, dashpots 0.1).
+Settled settle(Scene s, Integrator integrator, Precision precision, double tol, std::int64_t max_steps) {
+  s.solver.integrator = integrator;
+  s.solver.precision = precision;
+  s.solver.damping_per_s = 30;
+  s.solver.dashpot_ratio = 0.1;
+  s.stop.equilibrium = tol;
+  s.stop.max_steps = max_steps;
+  Settled run{test::make_model(s), {}};
+  Simulator sim(s, run.model.lattice, run.model.elements, test::cl_context());
+  run.out = run_simulation(s, run.model.lattice, run.model.elements, sim);
+  return run;
+}
+
 struct HangingRun {
   RunOutput out;
   double bottom_z = 0;  ///< the bottom-centre element's height at the end (m)
@@ -34,10 +67,7 @@ struct HangingRun {
 /// comes down to `top_z` in 0.1 s, so the element rides down on it (no obstacle: top_z infinite).
 /// The torus: R = 5 mm, r = 3 mm, axis z, shrinking; the sphere: radius 3 mm, moving down.
 HangingRun hang_over(Obstacle obstacle, Integrator integrator, double top_z) {
-  Scene s = test::box_scene(3, 3, 3, h, 3000);
-  s.anchors.push_back(test::halfspace_anchor("top", Vec3(0, 0, 0.004), Vec3::UnitZ()));
-  s.gravity.active = true;
-  s.gravity.acceleration_m_s2 = Vec3(0, 0, -g);
+  Scene s = hanging_block(3, 3, 3, Vec3::Zero());
   const double start_top = 0.001 - kGap, r = 0.003, time = 0.1;
   if (std::isfinite(top_z) && obstacle == Obstacle::Torus) {
     TorusSpec t;
@@ -56,17 +86,11 @@ HangingRun hang_over(Obstacle obstacle, Integrator integrator, double top_z) {
     b.travel_time_s = time;
     s.indenters.push_back(b);
   }
-  s.solver.integrator = integrator;
-  s.solver.precision = Precision::Double;
-  s.solver.damping_per_s = 30;
-  s.solver.dashpot_ratio = 0.1;
-  s.stop.equilibrium = 1e-7;
-  s.stop.max_steps = 50000;
-  const auto m = test::make_model(s);
-  Simulator sim(s, m.lattice, m.elements, test::cl_context());
+  Settled settled = settle(s, integrator, Precision::Double, 1e-7, 50000);
   HangingRun run;
-  run.out = run_simulation(s, m.lattice, m.elements, sim);
-  run.bottom_z = run.out.state.position_m[3 * nearest_element(m.lattice, Vec3(0.003, 0.003, 0.001)) + 2];
+  run.bottom_z =
+      settled.out.state.position_m[3 * nearest_element(settled.model.lattice, Vec3(0.003, 0.003, 0.001)) + 2];
+  run.out = std::move(settled.out);
   return run;
 }
 
@@ -104,12 +128,7 @@ INSTANTIATE_TEST_SUITE_P(Obstacles, ContactBand,
 /// sphere: radius 20 mm (a dozen elements rest on it); the torus: R = 4 mm, axis z, its tube
 /// inflating from r = 2 to 3 mm.
 RunOutput rest_on(Obstacle obstacle, Precision precision, const Vec3& offset) {
-  Scene s = test::box_scene(5, 5, 4, h, 3000);
-  s.model.shapes[0].min_m += offset;
-  s.model.shapes[0].max_m += offset;
-  s.anchors.push_back(test::halfspace_anchor("top", offset + Vec3(0, 0, 0.006), Vec3::UnitZ()));
-  s.gravity.active = true;
-  s.gravity.acceleration_m_s2 = Vec3(0, 0, -g);
+  Scene s = hanging_block(5, 5, 4, offset);
   const Vec3 under = offset + Vec3(0.005, 0.005, 0.0);  // the bottom face's centre
   const double start_top = 0.5e-3, rise = 1e-3, time = 0.1;  // the obstacle's top, above the face
   if (obstacle == Obstacle::Torus) {
@@ -128,15 +147,7 @@ RunOutput rest_on(Obstacle obstacle, Precision precision, const Vec3& offset) {
     b.travel_time_s = time;
     s.indenters.push_back(b);
   }
-  s.solver.integrator = Integrator::Heun;
-  s.solver.precision = precision;
-  s.solver.damping_per_s = 30;
-  s.solver.dashpot_ratio = 0.1;
-  s.stop.equilibrium = 1e-6;
-  s.stop.max_steps = 30000;
-  const auto m = test::make_model(s);
-  Simulator sim(s, m.lattice, m.elements, test::cl_context());
-  return run_simulation(s, m.lattice, m.elements, sim);
+  return settle(s, Integrator::Heun, precision, 1e-6, 30000).out;
 }
 
 class FloatRest : public ::testing::TestWithParam<Obstacle> {};
