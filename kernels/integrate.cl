@@ -13,7 +13,7 @@
 // multiplier the last corrections left (kernels/volume.cl: M ← μ + M/2), so at a constrained
 // equilibrium ṽ = v + dt·w·(f − p·g) = 0, as with the projection. less_lag subtracts that force
 // from the lattice force f, as one fused multiply-add, so that the CPU lanes kernels
-// (integrate_lanes.cl), which do it on scalar components, round it identically whatever the
+// (integrate_lanes.cl), which do it on float8 vectors, round it identically whatever the
 // compiler contracts; with `lag` 0 (a constant at each call) it costs nothing.
 #define VB_LAG_PARAMS int lag, global const real4 *lag_g, real lag_p
 #define VB_LAG_ARGS lag, lag_g, lag_p

@@ -1,90 +1,139 @@
 // Heun, symplectic Euler and dynamic relaxation (kernels/relax.cl) steps of spring models on CPUs
-// (VB_LANES, docs/PERF_NOTES.md change 14): the same arithmetic as heun_predict, heun_correct,
-// euler_step and relax_step on linear springs with gravity, global damping and dashpots, written
-// on scalar components instead of real4.
-// Why a second form: PoCL runs a work-group as a loop over its work-items and lets LLVM's loop
-// vectoriser widen that loop, one work-item per SIMD lane; LLVM does not widen real4 values
-// ("instruction return type cannot be vectorized"), so the real4 kernels run one element at a time.
-// On scalars LLVM widens the loop 8 work-items wide (AVX-512 CPU, 256-bit vectors preferred: one
-// vsqrtps per 8 square roots, the neighbours' loads gathered). Float only: in double LLVM's cost
-// model declines the gathers, and the scalar form ran slower than the real4 one. Only scenes
-// without indenters, tori, triangle contact, pending volume projections, rest offsets,
-// hyperelastic or biphasic tissue use it (Simulator: lanes_); they are the plain lattice of most
-// positioning and fitting runs.
+// (VB_LANES, docs/PERF_NOTES.md changes 14 and 31): the same arithmetic as heun_predict,
+// heun_correct, euler_step and relax_step on linear springs with gravity, global damping and
+// dashpots, each work-item stepping VB_LANE_WIDTH free elements at once in float8 vectors.
+// Why a second form: PoCL runs a work-group as a loop over its work-items, and the real4 kernels
+// step one element per iteration on scalar SSE instructions. Change 14 wrote them on scalar
+// components and left the widening across work-items to LLVM's loop vectoriser; its cost model
+// accepted the neighbours' gathers on AVX-512 CPUs only, so on AVX2 CPUs (AMD EPYC Zen 3, PoCL's
+// "haswell") the loop ran scalar again, with no sign but the speed. Here the vectors are written
+// out: every CPU with 256-bit vectors runs 8 elements per instruction, whatever a cost model says.
+// Float only (Simulator: lanes_). Only scenes without indenters, tori, triangle contact, pending
+// volume projections, rest offsets, hyperelastic or biphasic tissue use it; they are the plain
+// lattice of most positioning and fitting runs.
 #if VB_LANES
-
-typedef struct {
-  real x, y, z;
-} lane3;
-
-// The square root as LLVM's intrinsic (correctly rounded, as OpenCL's sqrt on PoCL): PoCL's library
-// sqrt is a call it never inlines, and a call stops the vectoriser. OpenCL's sqrt for compilers
-// that are not clang-based (no __builtin_sqrtf).
-#if !defined(__clang__)
-#define lane_sqrt sqrt
-#elif VB_DOUBLE
-#define lane_sqrt __builtin_sqrt
-#else
-#define lane_sqrt __builtin_sqrtf
+#if VB_DOUBLE
+#error "the lanes kernels are float only (Simulator::lanes_)"
 #endif
 
-// Element e's (x, y, z) from a real4 array read as reals: scalar loads, which LLVM gathers. `one` is
-// 1, passed at run time (a kernel argument): with a constant 1 LLVM's SLP vectoriser, which PoCL
-// runs before the work-item loop vectoriser, pairs the adjacent x and y loads into 2-wide vectors,
-// and a vector-typed value in the loop stops the loop vectoriser (its remark: "instruction return
-// type cannot be vectorized"); with `one` unknown the compiler cannot tell the loads are adjacent.
-VB_INLINE lane3 lane_xyz(global const real* a, uint e, int one) {
-  const lane3 r = {a[4 * e], a[4 * e + one], a[4 * e + 2 * one]};
-  return r;
+// Elements per work-item: one 256-bit vector of floats (engine/sim/kernel_arg_layout.hpp has the
+// host's copy, kLaneWidth, which pads the free list to a multiple of it).
+#define VB_LANE_WIDTH 8
+
+typedef struct {
+  float8 x, y, z;
+} lanes3;
+// a[j.s0] … a[j.s7]: eight scalar loads.
+VB_INLINE float8 gather(global const float* a, uint8 j) {
+  return (float8)(a[j.s0], a[j.s1], a[j.s2], a[j.s3], a[j.s4], a[j.s5], a[j.s6], a[j.s7]);
 }
 
-VB_INLINE real lane_w(global const real* a, uint e, int one) { return a[4 * e + 3 * one]; }
-
-VB_INLINE void lane_store(global real* a, uint e, lane3 p, real w, int one) {
-  a[4 * e] = p.x;
-  a[4 * e + one] = p.y;
-  a[4 * e + 2 * one] = p.z;
-  a[4 * e + 3 * one] = w;
+VB_INLINE int8 gather_int(global const int* a, int8 j) {
+  return (int8)(a[j.s0], a[j.s1], a[j.s2], a[j.s3], a[j.s4], a[j.s5], a[j.s6], a[j.s7]);
 }
 
-// Lattice force on element e (N): lattice_force_pending of kernels/lattice_forces.cl for linear
-// springs (and dashpots under VB_DASHPOT), term by term in the same order. (Its short loop for
-// uniform neighbourhoods, lattice_force_uniform, is not used with the lanes kernels: as a branch
-// it stopped PoCL's vectoriser, 36k linear Heun 446 → 190 steps/s, and as a select it saves
-// nothing on a CPU.)
-VB_INLINE lane3 lane_lattice_force(uint e, lane3 ui, real wi, lane3 vi, global const real* u, global const real* v,
-                                   global const real* E, global const uint* cell_of, global const int* grid, int sy,
-                                   int sz, real h, real dashpot_ratio, int one) {
-  const int cell = (int)cell_of[e];
-  const real Ei = E[e];
-  lane3 f = {0, 0, 0};
-#pragma unroll
+// The components of eight float4 as four float8: r0 … r3 hold elements (0, 4), (1, 5), (2, 6),
+// (3, 7), one per 128-bit half; a 4 × 8 transpose in shuffles.
+VB_INLINE void transpose4(float8 r0, float8 r1, float8 r2, float8 r3, float8* x, float8* y, float8* z, float8* w) {
+  // per half: (x0 x1 y0 y1), (z0 z1 w0 w1) of elements 0, 1 (4, 5) and of 2, 3 (6, 7)
+  const float8 xy01 = (float8)(r0.s0, r1.s0, r0.s1, r1.s1, r0.s4, r1.s4, r0.s5, r1.s5);
+  const float8 zw01 = (float8)(r0.s2, r1.s2, r0.s3, r1.s3, r0.s6, r1.s6, r0.s7, r1.s7);
+  const float8 xy23 = (float8)(r2.s0, r3.s0, r2.s1, r3.s1, r2.s4, r3.s4, r2.s5, r3.s5);
+  const float8 zw23 = (float8)(r2.s2, r3.s2, r2.s3, r3.s3, r2.s6, r3.s6, r2.s7, r3.s7);
+  *x = (float8)(xy01.s01, xy23.s01, xy01.s45, xy23.s45);
+  *y = (float8)(xy01.s23, xy23.s23, xy01.s67, xy23.s67);
+  *z = (float8)(zw01.s01, zw23.s01, zw01.s45, zw23.s45);
+  *w = (float8)(zw01.s23, zw23.s23, zw01.s67, zw23.s67);
+}
+
+// The components of the eight float4 a[j.s0] … a[j.s7]: eight 16-byte loads (a gather per
+// component would take four times the loads).
+VB_INLINE void gather4(global const float4* a, uint8 j, float8* x, float8* y, float8* z, float8* w) {
+  transpose4((float8)(a[j.s0], a[j.s4]), (float8)(a[j.s1], a[j.s5]), (float8)(a[j.s2], a[j.s6]),
+             (float8)(a[j.s3], a[j.s7]), x, y, z, w);
+}
+
+// The same for a run a[j0] … a[j0 + 7]: addresses from one index, no lane taken apart.
+VB_INLINE void load4_run(global const float4* a, uint j0, float8* x, float8* y, float8* z, float8* w) {
+  a += j0;
+  transpose4((float8)(a[0], a[4]), (float8)(a[1], a[5]), (float8)(a[2], a[6]), (float8)(a[3], a[7]), x, y, z, w);
+}
+
+// a[e.sl] = (x.sl, y.sl, z.sl, w.sl) for the first `count` lanes (count ≥ 1): the transpose
+// backwards, then one 16-byte store per element.
+VB_INLINE void scatter4(global float4* a, uint8 e, uint count, float8 x, float8 y, float8 z, float8 w) {
+  const float8 xy01 = (float8)(x.s0, y.s0, x.s1, y.s1, x.s4, y.s4, x.s5, y.s5);
+  const float8 xy23 = (float8)(x.s2, y.s2, x.s3, y.s3, x.s6, y.s6, x.s7, y.s7);
+  const float8 zw01 = (float8)(z.s0, w.s0, z.s1, w.s1, z.s4, w.s4, z.s5, w.s5);
+  const float8 zw23 = (float8)(z.s2, w.s2, z.s3, w.s3, z.s6, w.s6, z.s7, w.s7);
+  a[e.s0] = (float4)(xy01.s01, zw01.s01);
+  if (count > 1) a[e.s1] = (float4)(xy01.s23, zw01.s23);
+  if (count > 2) a[e.s2] = (float4)(xy23.s01, zw23.s01);
+  if (count > 3) a[e.s3] = (float4)(xy23.s23, zw23.s23);
+  if (count > 4) a[e.s4] = (float4)(xy01.s45, zw01.s45);
+  if (count > 5) a[e.s5] = (float4)(xy01.s67, zw01.s67);
+  if (count > 6) a[e.s6] = (float4)(xy23.s45, zw23.s45);
+  if (count > 7) a[e.s7] = (float4)(xy23.s67, zw23.s67);
+}
+
+// (0, 1, …, 7): a run of indices is its first plus this.
+#define VB_LANE_IOTA ((int8)(0, 1, 2, 3, 4, 5, 6, 7))
+
+// Lattice force on elements e (N): lattice_force_pending of kernels/lattice_forces.cl for linear
+// springs (and dashpots under VB_DASHPOT), term by term in the same order, so each lane rounds as
+// the real4 kernel does. Where the 8 elements are a run of cells along x (`run`), so is each of
+// their neighbourhoods' 26 directions, and a direction whose 8 neighbours are all there, numbered
+// in a run, is read with plain vector loads; any other is gathered lane by lane. (The real4
+// form's short loop for uniform neighbourhoods, lattice_force_uniform, is not used here: a CPU
+// gains little from skipping the neighbour's E.)
+VB_INLINE lanes3 lanes_lattice_force(uint8 e, lanes3 ui, float8 wi, lanes3 vi, global const float4* u,
+                                     global const float4* v, global const float* E, global const uint* cell_of,
+                                     global const int* grid, int sy, int sz, float h, float dashpot_ratio) {
+  const int8 cell = gather_int((global const int*)cell_of, as_int8(e));
+  const int run = all(cell == cell.s0 + VB_LANE_IOTA);
+  const float8 Ei = gather(E, e);
+  lanes3 f = {(float8)0, (float8)0, (float8)0};
+#pragma unroll 2
   for (int d = 0; d < 26; ++d) {
-    // Branch-free, as in the real4 form: a missing neighbour reads the element itself, masked out.
-    const int jn = grid[cell + VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2]];
-    const real present = jn >= 0 ? (real)1 : (real)0;
-    const uint j = jn >= 0 ? (uint)jn : e;
-    const lane3 uj = lane_xyz(u, j, one);
-    const real rx = h * VB_DIR[d][0] + (uj.x - ui.x);
-    const real ry = h * VB_DIR[d][1] + (uj.y - ui.y);
-    const real rz = h * VB_DIR[d][2] + (uj.z - ui.z);
-    const real len_sq = rx * rx + ry * ry + rz * rz;
-    const real inv_len = len_sq > 0 ? 1 / lane_sqrt(len_sq) : (real)0;
-    const real len = len_sq * inv_len;
-    const real nx = rx * inv_len, ny = ry * inv_len, nz = rz * inv_len;
-    const real Ej = E[j];
-    const real rest = h * VB_DIR_LEN[d];
+    const int offset = VB_DIR[d][0] + sy * VB_DIR[d][1] + sz * VB_DIR[d][2];
+    float8 ujx, ujy, ujz, wj, Ej;
+    uint8 j;
+    int8 jn = run ? vload8(0, grid + cell.s0 + offset) : (int8)(-1);
+    const int dense = run && jn.s0 >= 0 && all(jn == jn.s0 + VB_LANE_IOTA);
+    if (dense) {
+      load4_run(u, jn.s0, &ujx, &ujy, &ujz, &wj);
+      Ej = vload8(0, E + jn.s0);
+    } else {
+      // Branch-free, as in the real4 form: a missing neighbour reads the element itself with E = 0,
+      // which zeroes its spring and dashpot exactly as the real4 form's factor `present` does.
+      if (!run) jn = gather_int(grid, cell + offset);
+      j = as_uint8(select(as_int8(e), jn, jn >= 0));
+      gather4(u, j, &ujx, &ujy, &ujz, &wj);
+      Ej = select((float8)0, gather(E, j), jn >= 0);
+    }
+    const float8 rx = h * VB_DIR[d][0] + (ujx - ui.x);
+    const float8 ry = h * VB_DIR[d][1] + (ujy - ui.y);
+    const float8 rz = h * VB_DIR[d][2] + (ujz - ui.z);
+    const float8 len_sq = rx * rx + ry * ry + rz * rz;
+    const float8 inv_len = select((float8)0, 1 / sqrt(len_sq), len_sq > 0);
+    const float8 len = len_sq * inv_len;
+    const float8 nx = rx * inv_len, ny = ry * inv_len, nz = rz * inv_len;
+    const float rest = h * VB_DIR_LEN[d];
 #if VB_DASHPOT
-    const real w_sum = wi + lane_w(u, j, one);
-    const real kE = present * VB_KAPPA[d] * h * (2 * Ei * Ej);
-    const real q = 1 / ((Ei + Ej) * w_sum);
-    const real k = kE * w_sum * q;
-    real magnitude = k * (len - rest);
-    const lane3 vj = lane_xyz(v, j, one);
-    magnitude += 2 * dashpot_ratio * lane_sqrt(kE * q) * ((vj.x - vi.x) * nx + (vj.y - vi.y) * ny + (vj.z - vi.z) * nz);
+    const float8 w_sum = wi + wj;
+    const float8 kE = VB_KAPPA[d] * h * (2 * Ei * Ej);
+    const float8 q = 1 / ((Ei + Ej) * w_sum);
+    const float8 k = kE * w_sum * q;
+    float8 magnitude = k * (len - rest);
+    float8 vjx, vjy, vjz, vjw;
+    if (dense)
+      load4_run(v, jn.s0, &vjx, &vjy, &vjz, &vjw);
+    else
+      gather4(v, j, &vjx, &vjy, &vjz, &vjw);
+    magnitude += 2 * dashpot_ratio * sqrt(kE * q) * ((vjx - vi.x) * nx + (vjy - vi.y) * ny + (vjz - vi.z) * nz);
 #else
-    const real k = present * VB_KAPPA[d] * h * (2 * Ei * Ej / (Ei + Ej));
-    const real magnitude = k * (len - rest);
+    const float8 k = VB_KAPPA[d] * h * (2 * Ei * Ej / (Ei + Ej));
+    const float8 magnitude = k * (len - rest);
 #endif
     f.x += magnitude * nx;
     f.y += magnitude * ny;
@@ -93,9 +142,9 @@ VB_INLINE lane3 lane_lattice_force(uint e, lane3 ui, real wi, lane3 vi, global c
   return f;
 }
 
-// Acceleration of a free element (w = 1/m ≠ 0) from its lattice force: acceleration_from of
+// Acceleration of free elements (w = 1/m ≠ 0) from their lattice force: acceleration_from of
 // kernels/integrate.cl without indenters.
-VB_INLINE lane3 lane_acceleration(lane3 f, real w, lane3 vi, real4 gravity, real damping) {
+VB_INLINE lanes3 lanes_acceleration(lanes3 f, float8 w, lanes3 vi, float4 gravity, float damping) {
 #if VB_GRAVITY
   f.x += gravity.x / w;
   f.y += gravity.y / w;
@@ -106,92 +155,102 @@ VB_INLINE lane3 lane_acceleration(lane3 f, real w, lane3 vi, real4 gravity, real
   f.y -= damping * vi.y / w;
   f.z -= damping * vi.z / w;
 #endif
-  const lane3 a = {f.x * w, f.y * w, f.z * w};
+  const lanes3 a = {f.x * w, f.y * w, f.z * w};
   return a;
 }
 
-// The kernels step the free elements only, work-item k the element free_list[k] (n_free of them,
-// ascending): held elements never move, so their entries in both state buffers stay as
-// Simulator::upload wrote them. (A masked branch would not save their work: the vectorised loop
-// computes every lane. On the phantom two thirds of the elements are the rigid chest wall.)
+// The kernels step the free elements only: work-item k the entries VB_LANE_WIDTH·k … of
+// free_list (ascending; n_free of them, the list padded to a multiple of the width with its last
+// entry, which the padding lanes compute and do not store). Held elements never change, so their
+// entries in both state buffers stay as Simulator::upload wrote them. (On the phantom two thirds of
+// the elements are the rigid chest wall.)
 
-// One explicit stage of a free element (integrate.cl, explicit_stage): Heun's predictor
+// The first of work-item k's elements in the free list, or n_free when it has none.
+VB_INLINE uint lanes_first(uint n_free) {
+  const uint first = (uint)get_global_id(0) * VB_LANE_WIDTH;
+  return first < n_free ? first : n_free;
+}
+
+// One explicit stage of free elements (integrate.cl, explicit_stage): Heun's predictor
 // ũ = u + dt·v, ṽ = v + dt·a(u, v), or a symplectic Euler step v' = v + dt·a(u, v), u' = u + dt·v'
 // (`symplectic`, a constant at each call). With `relax` (a constant too; kernels/relax.cl:
 // dynamic relaxation, symplectic) the acceleration is that of the fictitious dynamics,
-// a·relax_scale − c·v, and v.w is 0 as relax_step stores it. (A branch the compiler cannot
-// resolve, such as one on the pointer, would stop the vectoriser.)
-VB_INLINE void lane_explicit_stage(global const real4* u4, global const real4* v4, global real4* u_out,
-                                   global real4* v_out, VB_LATTICE_KERNEL_PARAMS, real dt, uint n_free, int one,
-                                   global const uint* free_list, int symplectic, int relax,
-                                   global const real* relax_scale, real c, VB_LAG_PARAMS) {
+// a·relax_scale − c·v, and v.w is 0 as relax_step stores it.
+VB_INLINE void lanes_explicit_stage(global const float4* u, global const float4* v, global float4* u_out,
+                                    global float4* v_out, VB_LATTICE_KERNEL_PARAMS, float dt, uint n_free,
+                                    global const uint* free_list, int symplectic, int relax,
+                                    global const float* relax_scale, float c, VB_LAG_PARAMS) {
   VB_UNPACK_LATTICE;
-  const uint k = get_global_id(0);
-  if (k >= n_free) return;
-  const uint e = free_list[k];
-  global const real* u = (global const real*)u4;
-  global const real* v = (global const real*)v4;
-  const lane3 ui = lane_xyz(u, e, one), vi = lane_xyz(v, e, one);
-  const real wi = lane_w(u, e, one), vw = lane_w(v, e, one);
-  lane3 f = lane_lattice_force(e, ui, wi, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio, one);
+  const uint first = lanes_first(n_free);
+  if (first == n_free) return;
+  const uint8 e = vload8(0, free_list + first);
+  lanes3 ui, vi;
+  float8 wi, vw;
+  gather4(u, e, &ui.x, &ui.y, &ui.z, &wi);
+  gather4(v, e, &vi.x, &vi.y, &vi.z, &vw);
+  lanes3 f = lanes_lattice_force(e, ui, wi, vi, u, v, E, cell_of, grid, sy, sz, h, dashpot_ratio);
   if (lag) {  // under the lagged constraint pressure (Heun's predicted stage, relaxation): integrate.cl's less_lag
-    const lane3 g = lane_xyz((global const real*)lag_g, e, one);
-    f.x = fma(-lag_p, g.x, f.x);
-    f.y = fma(-lag_p, g.y, f.y);
-    f.z = fma(-lag_p, g.z, f.z);
+    float8 gx, gy, gz, gw;
+    gather4(lag_g, e, &gx, &gy, &gz, &gw);
+    f.x = fma((float8)(-lag_p), gx, f.x);
+    f.y = fma((float8)(-lag_p), gy, f.y);
+    f.z = fma((float8)(-lag_p), gz, f.z);
   }
-  lane3 a = lane_acceleration(f, wi, vi, gravity, damping);
+  lanes3 a = lanes_acceleration(f, wi, vi, gravity, damping);
   if (relax) {
-    const real scale = relax_scale[e];
-    const lane3 fictitious = {a.x * scale - c * vi.x, a.y * scale - c * vi.y, a.z * scale - c * vi.z};
+    const float8 scale = gather(relax_scale, e);
+    const lanes3 fictitious = {a.x * scale - c * vi.x, a.y * scale - c * vi.y, a.z * scale - c * vi.z};
     a = fictitious;
   }
-  const lane3 vn = {vi.x + dt * a.x, vi.y + dt * a.y, vi.z + dt * a.z};
-  const lane3 vm = symplectic ? vn : vi;  // the velocity the element moves with
-  const lane3 un = {ui.x + dt * vm.x, ui.y + dt * vm.y, ui.z + dt * vm.z};
-  lane_store((global real*)u_out, e, un, wi, one);
-  lane_store((global real*)v_out, e, vn, relax ? 0 : vw, one);
+  const lanes3 vn = {vi.x + dt * a.x, vi.y + dt * a.y, vi.z + dt * a.z};
+  const lanes3 vm = symplectic ? vn : vi;  // the velocity the elements move with
+  const lanes3 un = {ui.x + dt * vm.x, ui.y + dt * vm.y, ui.z + dt * vm.z};
+  const uint count = min((uint)VB_LANE_WIDTH, n_free - first);
+  scatter4(u_out, e, count, un.x, un.y, un.z, wi);
+  scatter4(v_out, e, count, vn.x, vn.y, vn.z, relax ? (float8)0 : vw);
 }
 
 // The entries take the state as offsets into the state arena, as integrate.cl's (no obstacles
 // here: indenters_at is unused).
 kernel void heun_predict_lanes(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
-                               uint n_free, int one, global const uint* free_list VB_LAG_KERNEL_PARAMS VB_STATE_PARAM) {
-  lane_explicit_stage(VB_STEP_STATE_POINTERS, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 0, 0, 0, 0,
-                      VB_LAG_KERNEL_ARGS);
+                               uint n_free, global const uint* free_list VB_LAG_KERNEL_PARAMS VB_STATE_PARAM) {
+  lanes_explicit_stage(VB_STEP_STATE_POINTERS, VB_LATTICE_KERNEL_ARGS, dt, n_free, free_list, 0, 0, 0, 0,
+                       VB_LAG_KERNEL_ARGS);
 }
 
 kernel void euler_step_lanes(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
-                             uint n_free, int one, global const uint* free_list VB_STATE_PARAM) {
-  lane_explicit_stage(VB_STEP_STATE_POINTERS, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 0, 0, 0, VB_NO_LAG);
+                             uint n_free, global const uint* free_list VB_STATE_PARAM) {
+  lanes_explicit_stage(VB_STEP_STATE_POINTERS, VB_LATTICE_KERNEL_ARGS, dt, n_free, free_list, 1, 0, 0, 0, VB_NO_LAG);
 }
 
 // Heun's corrector: u' = u + dt/2·(v + ṽ), v' = (v + ṽ)/2 + dt/2·a(ũ, ṽ), forces from the predicted
 // stage.
 kernel void heun_correct_lanes(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
-                               uint n_free, int one, global const uint* free_list VB_STATE_PARAM) {
+                               uint n_free, global const uint* free_list VB_STATE_PARAM) {
   VB_UNPACK_LATTICE;
-  const uint k = get_global_id(0);
-  if (k >= n_free) return;
-  const uint e = free_list[k];
-  global real4* u4 = VB_STATE_AT(real4, u_at);
-  global real4* v4 = VB_STATE_AT(real4, v_at);
-  global const real* up_all = VB_STATE_AT(const real, u_out_at);  // the predicted stage
-  global const real* vp_all = VB_STATE_AT(const real, v_out_at);
-  global const real* u = (global const real*)u4;
-  global const real* v = (global const real*)v4;
-  const real wi = lane_w(u, e, one);
-  const lane3 ui = lane_xyz(u, e, one), vi = lane_xyz(v, e, one);
-  const lane3 up = lane_xyz(up_all, e, one), vp = lane_xyz(vp_all, e, one);
-  const lane3 a = lane_acceleration(
-      lane_lattice_force(e, up, wi, vp, up_all, vp_all, E, cell_of, grid, sy, sz, h, dashpot_ratio, one), wi, vp, gravity,
+  const uint first = lanes_first(n_free);
+  if (first == n_free) return;
+  const uint8 e = vload8(0, free_list + first);
+  global float4* u = VB_STATE_AT(float4, u_at);
+  global float4* v = VB_STATE_AT(float4, v_at);
+  global const float4* up_all = VB_STATE_AT(const float4, u_out_at);  // the predicted stage
+  global const float4* vp_all = VB_STATE_AT(const float4, v_out_at);
+  lanes3 ui, vi, up, vp;
+  float8 wi, vw, wp, vwp;
+  gather4(u, e, &ui.x, &ui.y, &ui.z, &wi);
+  gather4(v, e, &vi.x, &vi.y, &vi.z, &vw);
+  gather4(up_all, e, &up.x, &up.y, &up.z, &wp);
+  gather4(vp_all, e, &vp.x, &vp.y, &vp.z, &vwp);
+  const lanes3 a = lanes_acceleration(
+      lanes_lattice_force(e, up, wi, vp, up_all, vp_all, E, cell_of, grid, sy, sz, h, dashpot_ratio), wi, vp, gravity,
       damping);
-  const real mean = (real)0.5, half_dt = (real)0.5 * dt;
-  const lane3 vn = {(vi.x + vp.x) * mean + half_dt * a.x, (vi.y + vp.y) * mean + half_dt * a.y,
-                    (vi.z + vp.z) * mean + half_dt * a.z};
-  const lane3 un = {ui.x + half_dt * (vi.x + vp.x), ui.y + half_dt * (vi.y + vp.y), ui.z + half_dt * (vi.z + vp.z)};
-  lane_store((global real*)u4, e, un, wi, one);
-  lane_store((global real*)v4, e, vn, 0, one);
+  const float mean = 0.5f, half_dt = 0.5f * dt;
+  const lanes3 vn = {(vi.x + vp.x) * mean + half_dt * a.x, (vi.y + vp.y) * mean + half_dt * a.y,
+                     (vi.z + vp.z) * mean + half_dt * a.z};
+  const lanes3 un = {ui.x + half_dt * (vi.x + vp.x), ui.y + half_dt * (vi.y + vp.y), ui.z + half_dt * (vi.z + vp.z)};
+  const uint count = min((uint)VB_LANE_WIDTH, n_free - first);
+  scatter4(u, e, count, un.x, un.y, un.z, wi);
+  scatter4(v, e, count, vn.x, vn.y, vn.z, (float8)0);
 }
 
 #endif

@@ -45,12 +45,12 @@ kernel void relax_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENT
 }
 
 #if VB_LANES
-// relax_step on scalar components, for CPUs, over the free elements (kernels/integrate_lanes.cl:
-// why, which scenes, and free_list): the same operations in the same order.
+// relax_step for CPUs, 8 free elements per work-item (kernels/integrate_lanes.cl: why, which
+// scenes, and free_list): the same operations in the same order.
 kernel void relax_step_lanes(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENTER_AT_PARAMS, real dt,
-                             uint n_free, global const real* relax_scale, real c, int one,
+                             uint n_free, global const real* relax_scale, real c,
                              global const uint* free_list VB_LAG_KERNEL_PARAMS VB_STATE_PARAM) {
-  lane_explicit_stage(VB_STEP_STATE_POINTERS, VB_LATTICE_KERNEL_ARGS, dt, n_free, one, free_list, 1, 1, relax_scale, c,
-                      VB_LAG_KERNEL_ARGS);
+  lanes_explicit_stage(VB_STEP_STATE_POINTERS, VB_LATTICE_KERNEL_ARGS, dt, n_free, free_list, 1, 1, relax_scale, c,
+                       VB_LAG_KERNEL_ARGS);
 }
 #endif

@@ -18,6 +18,8 @@ inline constexpr std::size_t kSplitWorkGroup = 128, kSplitMaxElements = 98304;
 // ranged 60–78k (level in the mean); at 47k the launched step won by 3%, at 64k–216k by 26–53%
 // (H200; docs/PERF_NOTES.md changes 24 and 25).
 inline constexpr std::size_t kPersistentMaxElements = 45056;
+// VB_LANE_WIDTH (kernels/integrate_lanes.cl): free elements per work-item of the CPU lanes kernels
+inline constexpr std::size_t kLaneWidth = 8;
 inline constexpr int kCheckBaseSlots = 5, kCheckSlotsPerIndenter = 4;  // kernels/checks.cl
 inline constexpr int kCheckSlotsPerTorus = 8;                             // VB_TORUS_SLOTS
 inline constexpr int kIndenterStride = 20;                                // VB_IND_STRIDE

@@ -385,9 +385,9 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
     const int k = std::atoi(env);
     if (heun_steps && (k == 1 || k == 2 || k == 4)) force_split_ = k;
   }
-  // Every integrator on CPUs for plain float spring models: the kernels on scalar components that
-  // PoCL widens across work-items (kernels/integrate_lanes.cl, relax.cl); VOXBREAST_LANES=0 keeps
-  // the real4 kernels, to compare.
+  // Every integrator on CPUs for plain float spring models: the kernels that step 8 elements per
+  // work-item in float8 vectors (kernels/integrate_lanes.cl, relax.cl); VOXBREAST_LANES=0 keeps the
+  // real4 kernels, to compare.
   lanes_ = !cl.info.is_gpu && precision_ == Precision::Float && !el.hyperelastic && !el.biphasic &&
            scene.indenters.empty() && scene.tori.empty() && !tri_contact_ && !folded && !rest_offsets_ &&
            force_split_ == 1;
@@ -417,7 +417,7 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
   // connection loop (kernels/lattice_forces.cl, lattice_force_uniform; PERF_NOTES.md change 22),
   // marked by a negative E in whole warps (uniform_neighbourhood.hpp). Not in the one-launch step,
   // whose register cap the second loop overflows (36k cube 72.9k → 47.9k steps/s on the H200), nor
-  // with the lanes kernels (they would need it without a branch, which saves nothing on a CPU). Off
+  // with the lanes kernels (skipping the neighbour's E saves little on a CPU). Off
   // by default with the step list (the H200 ran both together 11% slower than the short loop alone
   // on the 1.5M cube, and 4% slower than the list alone on the phantom). VOXBREAST_UNIFORM_PATH=0|1
   // overrides the device rule, not the others.
@@ -444,22 +444,22 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
 
 void Simulator::make_lane_args() {
   // The lanes kernels step the free elements only (kernels/integrate_lanes.cl), in ascending order.
+  // kLaneWidth elements per work-item: the list padded to a multiple of it with its last entry
+  // (a placeholder 0 when nothing is free: OpenCL has no empty buffers)
   std::vector<cl_uint> free_list = free_elements(inverse_mass_);
-  const std::size_t n_free = free_list.size();
-  if (free_list.empty()) free_list.push_back(0);  // a placeholder: OpenCL has no empty buffers
+  const std::size_t n_free = free_list.size(), items = (n_free + kLaneWidth - 1) / kLaneWidth;
+  free_list.resize(std::max<std::size_t>(1, items) * kLaneWidth, free_list.empty() ? 0 : free_list.back());
   free_list_ = cl::Buffer(cl_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, free_list.size() * sizeof(cl_uint),
                           free_list.data());
   device_bytes_ += free_list.size() * sizeof(cl_uint);
   const std::size_t wg = kCheckWorkGroup;
-  step_global_ = cl::NDRange(std::max<std::size_t>(1, (n_free + wg - 1) / wg) * wg);
-  // after n: the free count, `one` (1 at run time, so the compiler cannot pair adjacent loads),
-  // the list; relaxation has its scale and damping first
+  step_global_ = cl::NDRange(std::max<std::size_t>(1, (items + wg - 1) / wg) * wg);
+  // after n: the free count, then the list; relaxation has its scale and damping between them
   for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_}) {
     if (!(*k)()) continue;
     const int n_arg = kStepIndenter + kIndenterArgs + 1, extra = k == &relax_kernel_ ? 2 : 0;
     k->setArg(n_arg, cl_uint(n_free));
-    k->setArg(n_arg + extra + 1, cl_int(1));
-    k->setArg(n_arg + extra + 2, free_list_);
+    k->setArg(n_arg + extra + 1, free_list_);
   }
   mirror_state();  // upload ran before the lanes were chosen
 }

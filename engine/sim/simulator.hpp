@@ -185,8 +185,9 @@ class Simulator {
   /// work-items per element in Heun's force passes (kernels/integrate.cl, VB_SPLIT): 2 on GPUs for
   /// hyperelastic models up to 98,304 elements, else 1; VOXBREAST_FORCE_SPLIT=1|2|4 overrides
   int force_split() const { return force_split_; }
-  /// every integrator steps with the CPU kernels on scalar components, over the free elements
-  /// (kernels/integrate_lanes.cl): CPU devices, plain float spring models; VOXBREAST_LANES=0 turns them off
+  /// every integrator steps with the CPU kernels that take 8 free elements per work-item in float8
+  /// vectors (kernels/integrate_lanes.cl): CPU devices, plain float spring models; VOXBREAST_LANES=0
+  /// turns them off
   bool lanes() const { return lanes_; }
   /// Heun's whole step runs as one launch (kernels/persistent.cl; NVIDIA GPUs, small models)
   bool persistent_step() const { return persistent_.on; }
@@ -351,7 +352,7 @@ class Simulator {
   mutable bool pending_ = false;  ///< (u_, v_) has a projection pending (vol_grad_, vol_scalars_)
   int force_split_ = 1;
   bool lanes_ = false;  ///< the stepping kernels of kernels/integrate_lanes.cl (VB_LANES)
-  /// the lanes kernels' arguments: the free elements' list (free_list_), their count, `one`
+  /// the lanes kernels' arguments: the free elements' list (free_list_, padded to kLaneWidth), their count
   void make_lane_args();
   /// copies (u, v) into the scratch pair (u_tmp_, v_tmp_): the lanes kernels and the listed step
   /// (step_list_) never write held elements, so both pairs must hold them (upload, make_lane_args)

@@ -39,9 +39,9 @@ block = next(r for r in rows if r["model"] == "block")
 assert int(block["free_elements"]) == 8**3 - 8**2, block  # the cube's base layer is held
 print("breast throughput rows:", {m: round(float(r["steps_per_s"]), 1) for m, r in breast.items()})
 PY
-# On PoCL every row here (float, linear springs, no contact) steps with the kernels CPUs vectorise
+# On PoCL every row here (float, linear springs, no contact) steps with the CPUs' float8 kernels
 # (kernels/integrate_lanes.cl): a scene feature that silently sent them back to the real4 kernels
-# would cost ~1.7x.
+# would cost ~3x (PERF_NOTES.md change 31).
 /usr/bin/python3 - "$work/throughput/bench.json" <<'PY'
 import json, sys
 bench = json.load(open(sys.argv[1]))

@@ -1,5 +1,5 @@
-// The CPU stepping kernels on scalar components (kernels/integrate_lanes.cl, VB_LANES) against the
-// real4 kernels they replace on CPUs (kernels/integrate.cl, VOXBREAST_LANES=0). Run where the default
+// The CPU stepping kernels on float8 vectors, 8 free elements per work-item (kernels/integrate_lanes.cl,
+// VB_LANES) against the real4 kernels they replace on CPUs (kernels/integrate.cl, VOXBREAST_LANES=0). Run where the default
 // device is a CPU (PoCL in CI); on a GPU the lanes form is not used and the comparisons skip.
 #include <gtest/gtest.h>
 
@@ -18,8 +18,10 @@ namespace vb {
 namespace {
 
 /// A 9×10×11 block, base layer held (900 free elements, the lanes kernels' work-items: not a
-/// multiple of the SIMD width, so the last vector is part-filled), under gravity, with dashpots
-/// and global damping: every term of the lanes kernels.
+/// multiple of the vector width, so the last vector is part-filled), under gravity, with dashpots
+/// and global damping: every term of the lanes kernels. Its rows of 9 give both of their ways to
+/// read neighbours: a work-item inside a row reads most directions as runs of 8 (vector loads),
+/// one across two rows, and the directions off the block, lane by lane.
 Scene block(bool volume, Integrator integrator = Integrator::Heun) {
   Scene s = test::box_scene(9, 10, 11, 0.005, 3000);
   s.anchors.push_back(test::halfspace_anchor("base", Vec3(0, 0, 0.0025), Vec3(0, 0, -1)));
@@ -70,8 +72,8 @@ std::vector<double> run(const Scene& s, bool lanes) {
 // held element that moved, a free element left out, or a held element's stale entry in the
 // scratch state (the lanes kernels step the free elements only) would give another trajectory.
 // The forms differ only where the compiler may fuse a·b + c differently (-cl-mad-enable) in
-// vector and scalar code; on PoCL (AMD EPYC, AVX-512) they agreed exactly; the bound leaves room
-// for other fusing.
+// float8 and float4 code; on PoCL (AMD EPYC Zen 3, AVX2; the scalar form of change 14 on Zen 4,
+// AVX-512) they agreed exactly; the bound leaves room for other fusing.
 TEST(LanesStep, MatchesReal4Kernels) {
   const std::map<Integrator, std::string> names = {
       {Integrator::Heun, "Heun"}, {Integrator::SymplecticEuler, "symplectic Euler"}, {Integrator::Relaxation, "relaxation"}};
