@@ -23,6 +23,7 @@
 typedef struct {
   float8 x, y, z;
 } lanes3;
+
 // a[j.s0] … a[j.s7]: eight scalar loads.
 VB_INLINE float8 gather(global const float* a, uint8 j) {
   return (float8)(a[j.s0], a[j.s1], a[j.s2], a[j.s3], a[j.s4], a[j.s5], a[j.s6], a[j.s7]);
