@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Session 40, one device call: issue 7's GPU target rows at this commit (the 1.5M cube with its
+# Prepared in session 40 and not run (no device machine could be started in ten calls): issue 7's
+# GPU target rows at this commit (the 1.5M cube with its
 # gather floor and the copy bandwidth; the 36k breast, two-term Ogden + Heun + volume), then
 # test_physics on the GPU (the lanes kernels changed this session are CPU-only: their tests skip
 # there; the rest checks the build). Text results only.
