@@ -1,6 +1,7 @@
-// The CPU stepping kernels on float8 vectors, 8 free elements per work-item (kernels/integrate_lanes.cl,
-// VB_LANES) against the real4 kernels they replace on CPUs (kernels/integrate.cl, VOXBREAST_LANES=0). Run where the default
-// device is a CPU (PoCL in CI); on a GPU the lanes form is not used and the comparisons skip.
+// The CPU stepping kernels on float8 vectors, 8 free elements per work-item
+// (kernels/integrate_lanes.cl, VB_LANES), against the real4 kernels they replace on CPUs
+// (kernels/integrate.cl, VOXBREAST_LANES=0). Run where the default device is a CPU (PoCL in CI);
+// on a GPU the lanes form is not used and the comparisons skip.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -20,8 +21,8 @@ namespace {
 /// A 9×10×11 block, base layer held (900 free elements, the lanes kernels' work-items: not a
 /// multiple of the vector width, so the last vector is part-filled), under gravity, with dashpots
 /// and global damping: every term of the lanes kernels. Its rows of 9 give both of their ways to
-/// read neighbours: a work-item inside a row reads most directions as runs of 8 (vector loads),
-/// one across two rows, and the directions off the block, lane by lane.
+/// read neighbours: a work-item inside a row reads most directions as runs of 8 (vector loads);
+/// a work-item across two rows, and any direction off the block, reads lane by lane.
 Scene block(bool volume, Integrator integrator = Integrator::Heun) {
   Scene s = test::box_scene(9, 10, 11, 0.005, 3000);
   s.anchors.push_back(test::halfspace_anchor("base", Vec3(0, 0, 0.0025), Vec3(0, 0, -1)));
