@@ -60,21 +60,19 @@ VB_INLINE void load4_run(global const float4* a, uint j0, float8* x, float8* y, 
   transpose4((float8)(a[0], a[4]), (float8)(a[1], a[5]), (float8)(a[2], a[6]), (float8)(a[3], a[7]), x, y, z, w);
 }
 
-// a[e.sl] = (x.sl, y.sl, z.sl, w.sl) for the first `count` lanes (count ≥ 1): the transpose
-// backwards, then one 16-byte store per element.
+// a[e.sl] = (x.sl, y.sl, z.sl, w.sl) for the first `count` lanes (count ≥ 1). transpose4 is its
+// own inverse: on (x, y, z, w) it gives elements (0, 4), (1, 5), (2, 6), (3, 7) as float4 halves.
 VB_INLINE void scatter4(global float4* a, uint8 e, uint count, float8 x, float8 y, float8 z, float8 w) {
-  const float8 xy01 = (float8)(x.s0, y.s0, x.s1, y.s1, x.s4, y.s4, x.s5, y.s5);
-  const float8 xy23 = (float8)(x.s2, y.s2, x.s3, y.s3, x.s6, y.s6, x.s7, y.s7);
-  const float8 zw01 = (float8)(z.s0, w.s0, z.s1, w.s1, z.s4, w.s4, z.s5, w.s5);
-  const float8 zw23 = (float8)(z.s2, w.s2, z.s3, w.s3, z.s6, w.s6, z.s7, w.s7);
-  a[e.s0] = (float4)(xy01.s01, zw01.s01);
-  if (count > 1) a[e.s1] = (float4)(xy01.s23, zw01.s23);
-  if (count > 2) a[e.s2] = (float4)(xy23.s01, zw23.s01);
-  if (count > 3) a[e.s3] = (float4)(xy23.s23, zw23.s23);
-  if (count > 4) a[e.s4] = (float4)(xy01.s45, zw01.s45);
-  if (count > 5) a[e.s5] = (float4)(xy01.s67, zw01.s67);
-  if (count > 6) a[e.s6] = (float4)(xy23.s45, zw23.s45);
-  if (count > 7) a[e.s7] = (float4)(xy23.s67, zw23.s67);
+  float8 r04, r15, r26, r37;
+  transpose4(x, y, z, w, &r04, &r15, &r26, &r37);
+  a[e.s0] = r04.lo;
+  if (count > 1) a[e.s1] = r15.lo;
+  if (count > 2) a[e.s2] = r26.lo;
+  if (count > 3) a[e.s3] = r37.lo;
+  if (count > 4) a[e.s4] = r04.hi;
+  if (count > 5) a[e.s5] = r15.hi;
+  if (count > 6) a[e.s6] = r26.hi;
+  if (count > 7) a[e.s7] = r37.hi;
 }
 
 // (0, 1, …, 7): a run of indices is its first plus this.
