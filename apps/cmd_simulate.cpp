@@ -62,9 +62,18 @@ int run_simulate(const SimulateOptions& o) {
   for (const TorusResult& t : s.tori)
     std::printf("torus %s: force %.4g N, %lld contact elements, peak pressure %.4g Pa\n", t.name.c_str(),
                 t.force_n.norm(), (long long)t.contact_elements, t.peak_pressure_pa);
-  if (report.positioning.tumour)
-    std::printf("tumour '%s' centroid moved %.3f mm\n", report.positioning.tumour->tissue.c_str(),
-                1e3 * report.positioning.tumour->displacement_m().norm());
+  if (const auto& tumour = report.positioning.tumour) {
+    // With a reference state the displacement is measured from the CT, so it is the change from
+    // the CT's posture to the scene's, both loaded by gravity.
+    const std::string from = scene.reference_state.active && !scene.reference_state.ct_posture.empty()
+                                 ? " from the CT (" + scene.reference_state.ct_posture + ")"
+                                 : " from the CT";
+    const std::string to = scene.gravity.posture.empty() ? "" : " to " + scene.gravity.posture;
+    std::printf("tumour '%s' centroid moved %.3f mm%s%s%s\n", tumour->tissue.c_str(),
+                1e3 * tumour->displacement_m().norm(), from.c_str(), to.c_str(),
+                scene.reference_state.active ? ", simulated from the unloaded state"
+                                             : " (the CT taken as unloaded: add [reference_state])");
+  }
   if (const auto& r = report.positioning.reference_state)
     std::printf("unloaded reference state: %d iterations, lands %.4f mm from the CT; it lies up to %.3f mm from the CT\n",
                 r->iterations, 1e3 * r->residual_max_m, 1e3 * r->max_rest_offset_m);

@@ -48,11 +48,21 @@ w = nib.load(d + "/warped_ct.nii.gz")
 assert w.shape == dvf.shape[:3]
 t = s["tracked"]["tumour_1"]["displacement_m"]
 assert t[1] < 0, t  # prone: anteriorly
+# The main job starts from the unloaded breast, estimated from the supine CT, and says so.
+r = s["reference_state"]
+assert r["converged"] and r["ct_posture"] == "supine" and r["iterations"] >= 2, r
+assert s["positioning"]["tumour"]["displacement_norm_m"] > 5e-4, s["positioning"]["tumour"]
+out = open(d + "/../ct.txt").read()
+assert "from the CT (supine) to prone, simulated from the unloaded state" in out, out
 PY
-then pass "CT phantom (DICOM) → summary, DVF, warped CT"
+then pass "CT phantom (DICOM) → summary, DVF, warped CT, supine → prone from the unloaded state"
 else fail "CT phantom"; cat "$work/ct.txt"; fi
-# The same CT as NIfTI must give the same result as the DICOM series.
-if "$bin" simulate "$root/data-samples/phantom/scene.toml" --out "$work/ct_nifti" --quiet >/dev/null 2>&1 \
+# The same CT as NIfTI must give the same result as the DICOM series (the main job's scene with
+# the NIfTI CT in place of the series).
+ph="$root/data-samples/phantom"
+sed -e "s|^image = \"dicom\"|image = \"$ph/ct.nii.gz\"|" -e "s|^labels = \"labels.nii.gz\"|labels = \"$ph/labels.nii.gz\"|" \
+  "$ph/scene_dicom.toml" >"$work/scene_nifti.toml"
+if "$bin" simulate "$work/scene_nifti.toml" --out "$work/ct_nifti" --quiet >/dev/null 2>&1 \
    && python3 - "$work/ct/summary.json" "$work/ct_nifti/summary.json" <<'PY'
 import json, sys
 a, b = (json.load(open(p)) for p in sys.argv[1:3])
