@@ -6,6 +6,7 @@
 #include "engine/loads/anchors.hpp"
 #include "engine/material/biphasic_spring.hpp"
 #include "engine/material/hyperelastic.hpp"
+#include "engine/sim/element_mass.hpp"
 
 namespace vb {
 
@@ -24,6 +25,7 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
 
   std::vector<double> E_of_tissue, stability_of_tissue, mass_of_tissue;
   std::vector<bool> rigid_tissue;  // held in place (bone)
+  std::vector<bool> hull_tissue;   // hyperelastic: the body is the hull of the element centres
   ElementArrays a;
   for (const std::string& tissue : lattice.tissue_names) {
     auto it = scene.materials.find(tissue);
@@ -35,6 +37,7 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
     require(m.density_kg_m3 > 0 && std::isfinite(m.density_kg_m3), "density must be positive", where);
     mass_of_tissue.push_back(m.density_kg_m3 * volume);
     rigid_tissue.push_back(m.rigid);
+    hull_tissue.push_back(m.hyperelastic());
     std::array<double, 12> row{};  // law 0: linear springs
     if (m.law == "linear" || m.rigid) {
       E_of_tissue.push_back(m.youngs_modulus_pa);
@@ -76,8 +79,10 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
     const int t = lattice.tissue_of_element[e];
     a.youngs_modulus_pa[e] = E_of_tissue[t];
     a.stability_modulus_pa[e] = stability_of_tissue[t];
-    a.mass_kg[e] = mass_of_tissue[t];
-    a.inverse_mass[e] = anchors.held[e] || rigid_tissue[t] ? 0.0 : 1.0 / mass_of_tissue[t];
+    // Its share of its tissue's body: the voxel for springs, the octants of the voxel that are
+    // complete dual cells (of any tissue) for hyperelastic tissue; never zero.
+    a.mass_kg[e] = mass_of_tissue[t] * mass_volume_fraction(lattice.neighbours(e), hull_tissue[t]);
+    a.inverse_mass[e] = anchors.held[e] || rigid_tissue[t] ? 0.0 : 1.0 / a.mass_kg[e];
     for (int c = 0; c < 3; ++c) a.displacement_m[3 * e + c] = anchors.displacement_m[e][c];
     a.held_count += a.inverse_mass[e] == 0;
   }

@@ -17,7 +17,7 @@ struct ElementArrays {
   /// E·(1 + 3·c3·εc²), the stiffest tangent); for hyperelastic tissues the P-wave modulus over
   /// the lattice's C11/E = 1.2, plus hourglass springs
   std::vector<double> stability_modulus_pa;
-  std::vector<double> mass_kg;            ///< n, density × voxel volume
+  std::vector<double> mass_kg;  ///< n, density × the element's share of its body (sim/element_mass.hpp)
   std::vector<double> inverse_mass;       ///< n, 1/kg; 0 for held elements
   std::vector<double> displacement_m;     ///< n×3 initial (prescribed for held elements)
   std::size_t held_count = 0;
