@@ -45,6 +45,35 @@ void warn_implausible_moduli(const Scene& scene, const Lattice& lattice, std::ve
   }
 }
 
+/// Hyperelastic tissue carries the mass of the hull of its element centres (docs/PHYSICS.md,
+/// "Mass"): say so where that drops more than half of a tissue's voxel mass (sheets or strands
+/// about two voxels thick or less), and where elements with no complete dual cell get the floor.
+void warn_lumped_mass(const Lattice& lattice, const ElementArrays& el, std::vector<std::string>& warnings) {
+  constexpr double kMassLossWarning = 0.5;
+  for (std::size_t t = 0; t < el.tissue_mass.size(); ++t) {
+    const ElementArrays::TissueMass& m = el.tissue_mass[t];
+    if (!m.hull_body) continue;
+    const char* name = lattice.tissue_names[t].c_str();
+    char text[400];
+    if (m.floored > 0) {
+      std::snprintf(text, sizeof text,
+                    "tissue '%s' (hyperelastic): %zu of its %zu elements have no complete dual cell around them "
+                    "(one-voxel strands or sheets, or isolated elements), so no elastic volume; each is given %g of a "
+                    "voxel's mass",
+                    name, m.floored, m.elements, kLeastVolumeFraction);
+      warnings.push_back(text);
+    }
+    const double loss = 1 - m.model_kg / m.voxel_kg;
+    if (loss > kMassLossWarning) {
+      std::snprintf(text, sizeof text,
+                    "tissue '%s' (hyperelastic) carries %.4g kg, %.0f%% less than its voxels (%.4g kg): its body is the "
+                    "hull of the element centres, and most of it is thinner than about two voxels",
+                    name, m.model_kg, 100 * loss, m.voxel_kg);
+      warnings.push_back(text);
+    }
+  }
+}
+
 }  // namespace
 
 PreparedModel prepare_model(const Scene& scene, const DeviceInfo* device) {
@@ -61,6 +90,7 @@ PreparedModel prepare_model(const Scene& scene, const DeviceInfo* device) {
   if (device) check_lattice_fits_device(scene, m.lattice, *device);
   m.elements = make_element_arrays(scene, m.lattice);
   warn_implausible_moduli(scene, m.lattice, m.warnings);
+  warn_lumped_mass(m.lattice, m.elements, m.warnings);
   return m;
 }
 

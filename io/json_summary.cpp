@@ -60,6 +60,30 @@ json optional_number(const std::optional<double>& x) { return x ? number(*x) : j
 
 }  // namespace
 
+json model_mass_to_json(const Lattice& lattice, const ElementArrays& el) {
+  json tissues = json::object();
+  double model = 0, voxels = 0, hull = 0, model_v = 0, voxels_v = 0, hull_v = 0;
+  for (std::size_t t = 0; t < el.tissue_mass.size(); ++t) {
+    const ElementArrays::TissueMass& m = el.tissue_mass[t];
+    const double rho = m.density_kg_m3;
+    tissues[lattice.tissue_names[t]] = {{"body", m.hull_body ? "hull" : "voxels"},
+                                        {"elements", m.elements},
+                                        {"mass_kg", number(m.model_kg)},
+                                        {"voxel_mass_kg", number(m.voxel_kg)},
+                                        {"hull_mass_kg", number(m.hull_kg)},
+                                        {"volume_m3", number(m.model_kg / rho)},
+                                        {"voxel_volume_m3", number(m.voxel_kg / rho)},
+                                        {"hull_volume_m3", number(m.hull_kg / rho)},
+                                        {"floored_elements", m.floored}};
+    model += m.model_kg, voxels += m.voxel_kg, hull += m.hull_kg;
+    model_v += m.model_kg / rho, voxels_v += m.voxel_kg / rho, hull_v += m.hull_kg / rho;
+  }
+  return {{"total_mass_kg", number(model)},   {"voxel_mass_kg", number(voxels)},
+          {"hull_mass_kg", number(hull)},     {"volume_m3", number(model_v)},
+          {"voxel_volume_m3", number(voxels_v)}, {"hull_volume_m3", number(hull_v)},
+          {"tissues", tissues}};
+}
+
 json positioning_to_json(const PositioningMetrics& m) {
   json out = {{"volume_change_fraction", number(m.volume_change)},
               {"surface_volume_change_fraction", number(m.surface_volume_change)},

@@ -21,15 +21,15 @@ import matplotlib.pyplot as plt
 
 # case name in the CSV → (label, style, colour)
 FULL_LOAD = {
-    "nh_nu0.45_g1": ("neo-Hookean ν 0.45, voxel masses (the model)", "o-", "C0"),
-    "nh_nu0.45_g1_hullmass": ("neo-Hookean ν 0.45, hull masses (diagnostic)", "s--", "C1"),
+    "nh_nu0.45_g1": ("neo-Hookean ν 0.45, hull masses (the model)", "o-", "C0"),
+    "nh_nu0.45_g1_voxelmass": ("neo-Hookean ν 0.45, voxel masses (diagnostic)", "s--", "C1"),
     "linear_nu0.25_g1": ("linear springs (ν 1/4)", "^-", "C2"),
 }
 SMALL_LOAD = {
     "nh_nu0.45_g0.03": ("neo-Hookean ν 0.45", "o-", "C3"),
     "nh_nu0.25_g0.03": ("neo-Hookean ν 0.25", "d-", "C4"),
     "linear_nu0.25_g0.03": ("linear springs (ν 1/4)", "^-", "C5"),
-    "nh_nu0.45_g0.03_hullmass": ("neo-Hookean ν 0.45, hull masses", "s--", "C1"),
+    "nh_nu0.45_g0.03_voxelmass": ("neo-Hookean ν 0.45, voxel masses", "s--", "C1"),
 }
 
 

@@ -103,11 +103,13 @@ void record_tori(const Scene& scene, double t_s, const StateCheck& c, std::vecto
 
 EquilibriumScales equilibrium_scales(const Lattice& lattice, const ElementArrays& el) {
   // Over the free elements: held tissue (rigid bone at 1 GPa, say) must not loosen the criterion.
+  // The wave speed from the density (a voxel's mass): a hyperelastic surface element's mass is
+  // its share of the body, not a lighter material.
   double E_max = 0, m_min = INFINITY;
   for (std::size_t e = 0; e < el.mass_kg.size(); ++e) {
     if (el.inverse_mass[e] == 0) continue;
     E_max = std::max(E_max, el.youngs_modulus_pa[e]);
-    m_min = std::min(m_min, el.mass_kg[e]);
+    m_min = std::min(m_min, el.volume_fraction.empty() ? el.mass_kg[e] : el.mass_kg[e] / el.volume_fraction[e]);
   }
   const double h = lattice.spacing_m;
   return {E_max * h * h, std::sqrt(E_max / (m_min / (h * h * h))),

@@ -224,6 +224,28 @@ if "$bin" simulate "$work/kpa.toml" --out "$work/kpa" --quiet >/dev/null 2>"$wor
   pass "modulus in kPa: $(cat "$work/kpa.err")"
 else fail "modulus in kPa warning"; cat "$work/kpa.err"; fi
 
+# Hyperelastic tissue carries the mass of the hull of its element centres (summary.json model); a
+# one-voxel sheet has no elastic volume: its elements get a floor of 1/8 voxel, with a warning
+{ scene | sed 's/^E = 3000.0/E = 3000.0\nlaw = "neo-hookean"\nnu = 0.45/; /^\[gravity\]/,+1d'
+  printf '[[model.shape]]\nkind = "box"\nmin = [0.0, 0.0, 0.012]\nmax = [0.01, 0.01, 0.014]\nlabel = "sheet"\n'
+  printf '[materials.sheet]\nE = 3000.0\nlaw = "neo-hookean"\nnu = 0.45\n'; } >"$work/sheet.toml"
+if "$bin" simulate "$work/sheet.toml" --out "$work/sheet" --quiet >/dev/null 2>"$work/sheet.err" &&
+   grep -q "^voxbreast: warning: tissue 'sheet' (hyperelastic): 25 of its 25 elements have no complete dual cell" "$work/sheet.err" &&
+   grep -q "^voxbreast: warning: tissue 'sheet' (hyperelastic) carries .* 88% less than its voxels" "$work/sheet.err" &&
+   ! grep -q "tissue 'soft'" "$work/sheet.err" &&
+   python3 - "$work/sheet/summary.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+m, v = s["model"], 0.002 ** 3 * 1000
+assert abs(m["total_mass_kg"] - (4 ** 3 + 25 / 8) * v) < 1e-12, m  # the block's hull (4 spacings), the sheet's floor
+assert abs(m["voxel_mass_kg"] - (125 + 25) * v) < 1e-12, m
+assert abs(m["hull_mass_kg"] - 4 ** 3 * v) < 1e-12, m
+assert m["tissues"]["sheet"]["floored_elements"] == 25 and m["tissues"]["soft"]["body"] == "hull", m
+assert len(s["warnings"]) == 2, s["warnings"]
+PY
+then pass "hull masses in summary.json; one-voxel sheet: $(head -1 "$work/sheet.err")"
+else fail "hull masses and one-voxel sheet warning"; cat "$work/sheet.err"; fi
+
 # A corrupt CT: the phantom scene with a truncated ct.nii.gz
 mkdir -p "$work/corrupt" && cp "$root/data-samples/phantom/labels.nii.gz" "$root/data-samples/phantom/scene.toml" "$work/corrupt/"
 head -c 2000 "$root/data-samples/phantom/ct.nii.gz" >"$work/corrupt/ct.nii.gz"

@@ -11,18 +11,18 @@
 // layer), so the clamped face is the plane of the top layer's centres. The nodes of a level are
 // every other node of the next finer level, which lets fields be compared point by point.
 //
-// The mass stays one voxel per element, so the free elements weigh (L + h)²·L·ρ, where the hull
-// puts (L − h/2)·L²·ρ on them (its half layer at the clamp rests on the held elements): the side
-// layers add about 2h/L and the free face's full (instead of half) voxels about h/L to the sag, an
-// overload of about 3h/L, first order in h. To separate it from the elastic discretisation, the
-// neo-Hookean study is repeated with "hull masses" (a test-only change: m_e = w_e·ρh³ with the
-// element's dual-volume fraction w_e of docs/PHYSICS.md, so the load is the hull's weight). Both
-// sequences converge to one answer; the hull-mass one moves by < 1% between levels.
+// Each hyperelastic element carries its dual volume's mass, m_e = w_e·ρh³ (docs/PHYSICS.md,
+// "Mass"), so the load is the hull's weight; the model moves by < 1% between levels. The study is
+// repeated with "voxel masses" (a test-only change: m_e = ρh³), which overload the hull: the free
+// elements weigh (L + h)²·L·ρ, where the hull puts (L − h/2)·L²·ρ on them (its half layer at the
+// clamp rests on the held elements), so the side layers add about 2h/L and the free face's full
+// (instead of half) voxels about h/L to the sag, an overload of about 3h/L, first order in h. Both
+// sequences converge to one answer.
 //
-// Expected order: 1, from the voxel-mass overload (observed 1.20, 1.09, 1.05 on h = 6…0.375 mm).
-// The elastic discretisation alone (hull masses) has an error 70× smaller at h = 6 mm and also
-// converges at about first order (0.96, 1.12, 1.33): the surface elements' one-sided fits and the
-// strain singularity along the clamped edges form a boundary layer one spacing thick.
+// Expected order: about 1 for both. The voxel-mass overload converges at 1.20, 1.09, 1.05 on
+// h = 6…0.375 mm. The model's own error is 70× smaller at h = 6 mm and also converges at about
+// first order (0.96, 1.12, 1.33): the surface elements' one-sided fits and the strain singularity
+// along the clamped edges form a boundary layer one spacing thick.
 //
 // The CI tests use two levels (n = 6 and 11; 11 and 21 for the small-strain field comparison) and
 // first-order Richardson extrapolation. The study on four or five levels runs only with
@@ -39,7 +39,6 @@
 #include <string>
 #include <vector>
 
-#include "engine/lattice/dual_cells.hpp"
 #include "engine/results/element_measures.hpp"
 #include "engine/sim/run.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
@@ -57,12 +56,12 @@ struct Case {
   std::string law;        ///< "neo-hookean" or "linear"
   double nu = 0.45;       ///< hyperelastic only (springs have ν = 1/4)
   double g_scale = 1.0;   ///< gravity = g_scale × 9.81 m/s²
-  bool hull_mass = false; ///< m_e = w_e·ρh³ instead of ρh³ (diagnostic)
+  bool voxel_mass = false; ///< m_e = ρh³ instead of the model's w_e·ρh³ (diagnostic)
 
   std::string name() const {
     char buf[96];
     std::snprintf(buf, sizeof buf, "%s_nu%.2f_g%g%s", law == "linear" ? "linear" : "nh", law == "linear" ? 0.25 : nu,
-                  g_scale, hull_mass ? "_hullmass" : "");
+                  g_scale, voxel_mass ? "_voxelmass" : "");
     return buf;
   }
 };
@@ -100,11 +99,11 @@ Hang hang(const Case& c, int n) {
   s.stop.max_steps = 200000;
   const auto start = std::chrono::steady_clock::now();
   test::Model model = test::make_model(s);
-  if (c.hull_mass)
+  if (c.voxel_mass)
     for (std::size_t e = 0; e < model.lattice.element_count(); ++e) {
-      const double w = dual_volume_fraction(model.lattice.neighbours(e));
-      model.elements.mass_kg[e] *= w;
-      if (model.elements.inverse_mass[e] != 0) model.elements.inverse_mass[e] /= w;
+      const double w = model.elements.volume_fraction[e];
+      model.elements.mass_kg[e] /= w;
+      model.elements.inverse_mass[e] *= w;
     }
   Simulator sim(s, model.lattice, model.elements, test::cl_context());
   const RunOutput out = run_simulation(s, model.lattice, model.elements, sim);
@@ -169,36 +168,36 @@ double observed_order(double q_h, double q_h2, double q_h4) {
 void record(const std::string& key, double value) { ::testing::Test::RecordProperty(key, std::to_string(value)); }
 
 const Case kNeoHookean{"neo-hookean", 0.45, 1.0, false};
-const Case kNeoHookeanHullMass{"neo-hookean", 0.45, 1.0, true};
+const Case kNeoHookeanVoxelMass{"neo-hookean", 0.45, 1.0, true};
 const Case kLinear{"linear", 0.25, 1.0, false};
 
-// The full load: the voxel-mass model at h = 6 and 3 mm against the hull-mass model, whose
-// extrapolated answer serves as the reference (it moves by < 1% from 6 to 3 mm). The error of the
-// voxel-mass model is the mass excess: it falls as h (two-level order within 0.7–2.5) and is
-// 2–4.5 × h/L at h = 3 mm (the 1-D estimate of the overload is 3h/L).
-TEST(SelfWeightConvergence, HangingNeoHookeanBlockConvergesAtFirstOrderFromTheVoxelMassExcess) {
-  const Hang hull6 = hang(kNeoHookeanHullMass, 6), hull11 = hang(kNeoHookeanHullMass, 11);
+// The full load: the model (hull masses) at h = 6 and 3 mm, whose extrapolated answer serves as
+// the reference (it moves by < 1% from 6 to 3 mm), against the voxel-mass diagnostic. Its error is
+// the mass excess: it falls as h (two-level order within 0.7–2.5) and is 2–4.5 × h/L at h = 3 mm
+// (the 1-D estimate of the overload is 3h/L).
+TEST(SelfWeightConvergence, HangingNeoHookeanBlockIsWithinOnePercentAndVoxelMassesOverloadItAtFirstOrder) {
   const Hang nh6 = hang(kNeoHookean, 6), nh11 = hang(kNeoHookean, 11);
-  const double reference = extrapolated_q(hull6, hull11);
-  const double hull_change = std::abs(hull6.q_m - hull11.q_m) / std::abs(hull11.q_m);
-  const double error6 = std::abs(nh6.q_m - reference) / std::abs(reference);
-  const double error11 = std::abs(nh11.q_m - reference) / std::abs(reference);
+  const Hang vox6 = hang(kNeoHookeanVoxelMass, 6), vox11 = hang(kNeoHookeanVoxelMass, 11);
+  const double reference = extrapolated_q(nh6, nh11);
+  const double change = std::abs(nh6.q_m - nh11.q_m) / std::abs(nh11.q_m);
+  const double error6 = std::abs(vox6.q_m - reference) / std::abs(reference);
+  const double error11 = std::abs(vox11.q_m - reference) / std::abs(reference);
   const double order = std::log2(error6 / error11);
-  std::printf("hull masses: q = %.6f, %.6f mm (change %.3f%%), limit %.6f mm\n", 1e3 * hull6.q_m, 1e3 * hull11.q_m,
-              100 * hull_change, 1e3 * reference);
+  std::printf("model (hull masses): q = %.6f, %.6f mm (change %.3f%%), limit %.6f mm\n", 1e3 * nh6.q_m,
+              1e3 * nh11.q_m, 100 * change, 1e3 * reference);
   std::printf("voxel masses: q = %.6f, %.6f mm, error %.2f%%, %.2f%% (= %.2f, %.2f h/L), order %.3f; "
-              "peak axis strain %.3f (hull %.3f)\n",
-              1e3 * nh6.q_m, 1e3 * nh11.q_m, 100 * error6, 100 * error11, error6 / 0.2, error11 / 0.1, order,
-              nh11.peak_axis_strain, hull11.peak_axis_strain);
+              "peak axis strain %.3f (model %.3f)\n",
+              1e3 * vox6.q_m, 1e3 * vox11.q_m, 100 * error6, 100 * error11, error6 / 0.2, error11 / 0.1, order,
+              vox11.peak_axis_strain, nh11.peak_axis_strain);
   record("self_weight_q_h6mm", nh6.q_m);
   record("self_weight_q_h3mm", nh11.q_m);
-  record("self_weight_hullmass_limit", reference);
-  record("self_weight_two_level_order", order);
+  record("self_weight_limit", reference);
+  record("self_weight_voxel_mass_two_level_order", order);
 
-  EXPECT_GE(hull11.peak_axis_strain, 0.20) << "the load must be large";
-  EXPECT_LT(hull_change, 0.01) << "the elastic discretisation alone (hull masses) is within 1% at 5 spacings across";
-  EXPECT_GT(std::abs(nh6.q_m), std::abs(nh11.q_m)) << "the voxel-mass excess falls with h, so the sag shrinks";
-  EXPECT_GT(std::abs(nh11.q_m), std::abs(reference)) << "the voxel-mass model is overloaded";
+  EXPECT_GE(nh11.peak_axis_strain, 0.20) << "the load must be large";
+  EXPECT_LT(change, 0.01) << "the model is within 1% at 5 spacings across";
+  EXPECT_GT(std::abs(vox6.q_m), std::abs(vox11.q_m)) << "the voxel-mass excess falls with h, so the sag shrinks";
+  EXPECT_GT(std::abs(vox11.q_m), std::abs(reference)) << "voxel masses overload the hull";
   EXPECT_GT(order, 0.7) << "first order expected (the mass excess is O(h))";
   EXPECT_LT(order, 2.5);
   EXPECT_GT(error11 / 0.1, 2.0) << "overload ≈ 3h/L expected";
@@ -212,14 +211,14 @@ TEST(SelfWeightConvergence, HangingNeoHookeanBlockConvergesAtFirstOrderFromTheVo
 // At large strain neo-Hookean softens in tension while the spring network does not, so the
 // departure must be larger.
 TEST(SelfWeightConvergence, LinearSpringsDepartFromNeoHookeanMoreAtLargeLoad) {
-  Case small_nh = kNeoHookeanHullMass, small_lin = kLinear;
+  Case small_nh = kNeoHookean, small_lin = kLinear;
   small_nh.g_scale = small_lin.g_scale = kSmallLoad;
   Case small_nh25 = small_nh;
   small_nh25.nu = 0.25;
   const double nh_small = extrapolated_q(hang(small_nh, 6), hang(small_nh, 11)) / kSmallLoad;
   const double nh25_small = extrapolated_q(hang(small_nh25, 6), hang(small_nh25, 11)) / kSmallLoad;
   const double lin_small = extrapolated_q(hang(small_lin, 6), hang(small_lin, 11)) / kSmallLoad;
-  const double nh_large = extrapolated_q(hang(kNeoHookeanHullMass, 6), hang(kNeoHookeanHullMass, 11));
+  const double nh_large = extrapolated_q(hang(kNeoHookean, 6), hang(kNeoHookean, 11));
   const double lin_large = extrapolated_q(hang(kLinear, 6), hang(kLinear, 11));
   const double small = lin_small / nh_small - 1, large = lin_large / nh_large - 1;
   const double small25 = lin_small / nh25_small - 1, nu_effect = nh25_small / nh_small - 1;
@@ -277,7 +276,7 @@ bool long_tests() {
 }
 
 // Levels n = 6, 11, 21, 41 (h = 6, 3, 1.5, 0.75 mm; VOXBREAST_SELF_WEIGHT_FINEST=81 adds
-// 0.375 mm). Cases: neo-Hookean ν 0.45 with voxel and with hull masses at the full and the small
+// 0.375 mm). Cases: neo-Hookean ν 0.45 (the model) and with voxel masses at the full and the small
 // load, and linear springs against neo-Hookean ν 0.25 at gravity scales 0.003 … 1 (the departure
 // as a function of strain). Writes self_weight_convergence.csv to VOXBREAST_VALIDATION_OUT (or
 // the build folder). Asserts the observed order of the voxel-mass model on the three finest
@@ -286,7 +285,7 @@ TEST(SelfWeightConvergence, LongStudyObservedOrderAndLinearDepartures) {
   if (!long_tests()) GTEST_SKIP() << "set VOXBREAST_LONG_TESTS=1 (about 1 h on 2 CPU cores; 25 s on an H200, 2.5 min with level 81)";
   std::vector<int> levels{6, 11, 21, 41};
   if (const char* f = std::getenv("VOXBREAST_SELF_WEIGHT_FINEST"); f && std::atoi(f) == 81) levels.push_back(81);
-  std::vector<Case> cases{kNeoHookean, kNeoHookeanHullMass, {"neo-hookean", 0.45, kSmallLoad, false},
+  std::vector<Case> cases{kNeoHookean, kNeoHookeanVoxelMass, {"neo-hookean", 0.45, kSmallLoad, false},
                           {"neo-hookean", 0.45, kSmallLoad, true}};
   const std::vector<double> loads{kTinyLoad, kSmallLoad, 0.1, 0.3, 1.0};
   for (const double g : loads) {
@@ -302,7 +301,7 @@ TEST(SelfWeightConvergence, LongStudyObservedOrderAndLinearDepartures) {
   const char* dir = std::getenv("VOXBREAST_VALIDATION_OUT");
   const std::string csv_path = std::string(dir ? dir : VOXBREAST_BINARY_DIR) + "/self_weight_convergence.csv";
   std::ofstream csv(csv_path);
-  csv << "case,law,nu,g_scale,hull_mass,n,h_m,q_m,peak_axis_strain,steps,wall_s\n";
+  csv << "case,law,nu,g_scale,voxel_mass,n,h_m,q_m,peak_axis_strain,steps,wall_s\n";
   for (const int n : levels)
     for (std::size_t c = 0; c < cases.size(); ++c) {
       const Hang r = hang(cases[c], n);
@@ -310,7 +309,7 @@ TEST(SelfWeightConvergence, LongStudyObservedOrderAndLinearDepartures) {
       char line[256];
       std::snprintf(line, sizeof line, "%s,%s,%.2f,%.3f,%d,%d,%.6e,%.12e,%.6f,%lld,%.2f\n", cases[c].name().c_str(),
                     cases[c].law.c_str(), cases[c].law == "linear" ? 0.25 : cases[c].nu, cases[c].g_scale,
-                    int(cases[c].hull_mass), n, r.h_m, r.q_m, r.peak_axis_strain, static_cast<long long>(r.steps),
+                    int(cases[c].voxel_mass), n, r.h_m, r.q_m, r.peak_axis_strain, static_cast<long long>(r.steps),
                     r.wall_s);
       csv << line << std::flush;
       std::printf("%s", line);
@@ -324,7 +323,7 @@ TEST(SelfWeightConvergence, LongStudyObservedOrderAndLinearDepartures) {
     return observed_order(r[last - 2].q_m, r[last - 1].q_m, r[last].q_m);
   };
   // Richardson with the observed order, from the two finest levels; the finest level itself when
-  // the sequence has no order (the hull-mass one at small load is flat to 3e-4 from h = 1.5 mm).
+  // the sequence has no order (the model at small load is flat to 3e-4 from h = 1.5 mm).
   auto limit_of = [&](const Case& c) {
     const auto& r = runs[index_of(c)];
     const double p = order_of(c);
@@ -337,15 +336,15 @@ TEST(SelfWeightConvergence, LongStudyObservedOrderAndLinearDepartures) {
     record(c.name() + "_order", order_of(c));
     record(c.name() + "_limit_m", limit_of(c));
   }
-  const double p = order_of(kNeoHookean);
-  EXPECT_GT(p, 0.7) << "voxel-mass model: first order expected";
+  const double p = order_of(kNeoHookeanVoxelMass);
+  EXPECT_GT(p, 0.7) << "voxel masses: first order expected";
   EXPECT_LT(p, 2.5);
-  const double nh = limit_of(kNeoHookean), nh_hull = limit_of(kNeoHookeanHullMass);
-  EXPECT_NEAR(nh / nh_hull, 1.0, 0.01) << "both mass models converge to one answer (full load)";
+  const double nh = limit_of(kNeoHookean), nh_voxel = limit_of(kNeoHookeanVoxelMass);
+  EXPECT_NEAR(nh_voxel / nh, 1.0, 0.01) << "both mass models converge to one answer (full load)";
   EXPECT_NEAR(limit_of({"neo-hookean", 0.45, kSmallLoad, false}) / limit_of({"neo-hookean", 0.45, kSmallLoad, true}),
               1.0, 0.01)
       << "both mass models converge to one answer (small load)";
-  EXPECT_GE(runs[index_of(kNeoHookeanHullMass)][last].peak_axis_strain, 0.20);
+  EXPECT_GE(runs[index_of(kNeoHookean)][last].peak_axis_strain, 0.20);
 
   // Departures of linear springs from the converged neo-Hookean answer.
   const double large = limit_of(kLinear) / nh - 1;
