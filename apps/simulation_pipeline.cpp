@@ -80,7 +80,7 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
   }
   io.lock();
   nlohmann::json summary = summary_to_json(result.summary, scene);
-  summary["model"] = model_mass_to_json(model.lattice, model.elements);
+  summary["model"] = model_mass_to_json(model.lattice, tissue_masses(scene, model.lattice, model.elements));
   report.positioning = compute_positioning_metrics(scene, model.lattice, model.elements, result.summary, result.state);
   if (reference) {
     report.positioning.reference_state = ReferenceStateMetrics{int(reference->history.size()), reference->converged,

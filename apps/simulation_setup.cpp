@@ -5,6 +5,7 @@
 
 #include "engine/image/image_lattice.hpp"
 #include "engine/lattice/voxelise.hpp"
+#include "engine/sim/element_mass.hpp"
 #include "engine/sim/device_memory.hpp"
 #include "engine/sim/simulator.hpp"
 #include "io/dicom_io.hpp"
@@ -48,10 +49,12 @@ void warn_implausible_moduli(const Scene& scene, const Lattice& lattice, std::ve
 /// Hyperelastic tissue carries the mass of the hull of its element centres (docs/PHYSICS.md,
 /// "Mass"): say so where that drops more than half of a tissue's voxel mass (sheets or strands
 /// about two voxels thick or less), and where elements with no complete dual cell get the floor.
-void warn_lumped_mass(const Lattice& lattice, const ElementArrays& el, std::vector<std::string>& warnings) {
+void warn_lumped_mass(const Scene& scene, const Lattice& lattice, const ElementArrays& el,
+                      std::vector<std::string>& warnings) {
   constexpr double kMassLossWarning = 0.5;
-  for (std::size_t t = 0; t < el.tissue_mass.size(); ++t) {
-    const ElementArrays::TissueMass& m = el.tissue_mass[t];
+  const std::vector<TissueMass> masses = tissue_masses(scene, lattice, el);
+  for (std::size_t t = 0; t < masses.size(); ++t) {
+    const TissueMass& m = masses[t];
     if (!m.hull_body) continue;
     const char* name = lattice.tissue_names[t].c_str();
     char text[400];
@@ -90,7 +93,7 @@ PreparedModel prepare_model(const Scene& scene, const DeviceInfo* device) {
   if (device) check_lattice_fits_device(scene, m.lattice, *device);
   m.elements = make_element_arrays(scene, m.lattice);
   warn_implausible_moduli(scene, m.lattice, m.warnings);
-  warn_lumped_mass(m.lattice, m.elements, m.warnings);
+  warn_lumped_mass(scene, m.lattice, m.elements, m.warnings);
   return m;
 }
 

@@ -60,11 +60,11 @@ json optional_number(const std::optional<double>& x) { return x ? number(*x) : j
 
 }  // namespace
 
-json model_mass_to_json(const Lattice& lattice, const ElementArrays& el) {
+json model_mass_to_json(const Lattice& lattice, const std::vector<TissueMass>& masses) {
   json tissues = json::object();
   double model = 0, voxels = 0, hull = 0, model_v = 0, voxels_v = 0, hull_v = 0;
-  for (std::size_t t = 0; t < el.tissue_mass.size(); ++t) {
-    const ElementArrays::TissueMass& m = el.tissue_mass[t];
+  for (std::size_t t = 0; t < masses.size(); ++t) {
+    const TissueMass& m = masses[t];
     const double rho = m.density_kg_m3;
     tissues[lattice.tissue_names[t]] = {{"body", m.hull_body ? "hull" : "voxels"},
                                         {"elements", m.elements},

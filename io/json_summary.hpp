@@ -4,7 +4,7 @@
 #include <string>
 
 #include "engine/scene/scene.hpp"
-#include "engine/sim/element_setup.hpp"
+#include "engine/sim/element_mass.hpp"
 #include "engine/sim/reference_state.hpp"
 #include "engine/sim/run_result.hpp"
 #include "engine/study/positioning_metrics.hpp"
@@ -16,7 +16,7 @@ nlohmann::json summary_to_json(const RunSummary& summary, const Scene& scene);
 
 /// summary.json's `model`: the modelled body's mass and volume, in total and per tissue, beside
 /// those of the union of the voxels and of the hull of the element centres (docs/OUTPUTS.md).
-nlohmann::json model_mass_to_json(const Lattice& lattice, const ElementArrays& elements);
+nlohmann::json model_mass_to_json(const Lattice& lattice, const std::vector<TissueMass>& tissues);
 
 /// The `positioning` section of summary.json (docs/OUTPUTS.md); absent parts are null.
 nlohmann::json positioning_to_json(const PositioningMetrics& metrics);

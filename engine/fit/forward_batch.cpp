@@ -38,8 +38,7 @@ ElementArrays concatenate(const std::vector<ElementArrays>& parts, bool own_rows
     const ElementArrays& p = parts[k];
     for (auto [to, from] : {std::pair{&out.youngs_modulus_pa, &p.youngs_modulus_pa},
                             std::pair{&out.stability_modulus_pa, &p.stability_modulus_pa},
-                            std::pair{&out.mass_kg, &p.mass_kg}, std::pair{&out.volume_fraction, &p.volume_fraction},
-                            std::pair{&out.inverse_mass, &p.inverse_mass},
+                            std::pair{&out.mass_kg, &p.mass_kg}, std::pair{&out.inverse_mass, &p.inverse_mass},
                             std::pair{&out.displacement_m, &p.displacement_m}})
       to->insert(to->end(), from->begin(), from->end());
     out.held_count += p.held_count;

@@ -1,13 +1,12 @@
 #include "engine/sim/element_setup.hpp"
 
-#include <algorithm>
 #include <cmath>
 
 #include "engine/error.hpp"
-#include "engine/lattice/dual_cells.hpp"
 #include "engine/loads/anchors.hpp"
 #include "engine/material/biphasic_spring.hpp"
 #include "engine/material/hyperelastic.hpp"
+#include "engine/sim/element_mass.hpp"
 
 namespace vb {
 
@@ -26,6 +25,7 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
 
   std::vector<double> E_of_tissue, stability_of_tissue, mass_of_tissue;
   std::vector<bool> rigid_tissue;  // held in place (bone)
+  std::vector<bool> hull_tissue;   // hyperelastic: the body is the hull of the element centres
   ElementArrays a;
   for (const std::string& tissue : lattice.tissue_names) {
     auto it = scene.materials.find(tissue);
@@ -37,10 +37,7 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
     require(m.density_kg_m3 > 0 && std::isfinite(m.density_kg_m3), "density must be positive", where);
     mass_of_tissue.push_back(m.density_kg_m3 * volume);
     rigid_tissue.push_back(m.rigid);
-    ElementArrays::TissueMass tm;
-    tm.density_kg_m3 = m.density_kg_m3;
-    tm.hull_body = m.hyperelastic();  // not rigid tissue: held whole, it keeps its voxels
-    a.tissue_mass.push_back(tm);
+    hull_tissue.push_back(m.hyperelastic());
     std::array<double, 12> row{};  // law 0: linear springs
     if (m.law == "linear" || m.rigid) {
       E_of_tissue.push_back(m.youngs_modulus_pa);
@@ -75,7 +72,6 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
   a.youngs_modulus_pa.resize(n);
   a.stability_modulus_pa.resize(n);
   a.mass_kg.resize(n);
-  a.volume_fraction.resize(n);
   a.inverse_mass.resize(n);
   a.displacement_m.assign(3 * n, 0.0);
   const AnchorPlacement anchors = place_anchors(lattice, scene.anchors);
@@ -83,22 +79,10 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
     const int t = lattice.tissue_of_element[e];
     a.youngs_modulus_pa[e] = E_of_tissue[t];
     a.stability_modulus_pa[e] = stability_of_tissue[t];
-    ElementArrays::TissueMass& tm = a.tissue_mass[t];
-    // Each element owns the part of its voxel inside its tissue's body: the whole voxel for
-    // springs, the octants that are complete dual cells (of any tissue) for hyperelastic tissue.
-    const double dual = dual_volume_fraction(lattice.neighbours(e));
-    double w = 1;
-    if (tm.hull_body) {
-      w = std::max(dual, kLeastVolumeFraction);
-      tm.floored += dual == 0;
-    }
-    a.volume_fraction[e] = w;
-    a.mass_kg[e] = mass_of_tissue[t] * w;
+    // Its share of its tissue's body: the voxel for springs, the octants of the voxel that are
+    // complete dual cells (of any tissue) for hyperelastic tissue; never zero.
+    a.mass_kg[e] = mass_of_tissue[t] * mass_volume_fraction(lattice.neighbours(e), hull_tissue[t]);
     a.inverse_mass[e] = anchors.held[e] || rigid_tissue[t] ? 0.0 : 1.0 / a.mass_kg[e];
-    tm.elements += 1;
-    tm.model_kg += a.mass_kg[e];
-    tm.voxel_kg += mass_of_tissue[t];
-    tm.hull_kg += mass_of_tissue[t] * dual;
     for (int c = 0; c < 3; ++c) a.displacement_m[3 * e + c] = anchors.displacement_m[e][c];
     a.held_count += a.inverse_mass[e] == 0;
   }

@@ -9,6 +9,7 @@
 #include "engine/device/torus.hpp"
 #include "engine/error.hpp"
 #include "engine/results/element_measures.hpp"
+#include "engine/sim/element_mass.hpp"
 #include "engine/surface/enclosed_volume.hpp"
 
 namespace vb {
@@ -109,7 +110,7 @@ EquilibriumScales equilibrium_scales(const Lattice& lattice, const ElementArrays
   for (std::size_t e = 0; e < el.mass_kg.size(); ++e) {
     if (el.inverse_mass[e] == 0) continue;
     E_max = std::max(E_max, el.youngs_modulus_pa[e]);
-    m_min = std::min(m_min, el.volume_fraction.empty() ? el.mass_kg[e] : el.mass_kg[e] / el.volume_fraction[e]);
+    m_min = std::min(m_min, el.mass_kg[e] / mass_volume_fraction(lattice, el, e));
   }
   const double h = lattice.spacing_m;
   return {E_max * h * h, std::sqrt(E_max / (m_min / (h * h * h))),

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "engine/lattice/dual_cells.hpp"
+#include "engine/sim/element_mass.hpp"
 #include "engine/sim/run.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
 
@@ -31,14 +32,15 @@ TEST(LumpedMass, HyperelasticCubeCarriesTheHullOfItsCentresAndSpringsTheirVoxels
   const double voxel = kRho * kH * kH * kH;
   const test::Model springs = test::make_model(s);
   EXPECT_NEAR(total_mass(springs.elements), n * n * n * voxel, 1e-12 * n * n * n * voxel);
-  for (const double w : springs.elements.volume_fraction) EXPECT_EQ(w, 1.0);
+  for (std::size_t e = 0; e < springs.lattice.element_count(); ++e)
+    EXPECT_EQ(mass_volume_fraction(springs.lattice, springs.elements, e), 1.0);
 
   s.materials["soft"].law = "neo-hookean";
   s.materials["soft"].poisson_ratio = 0.45;
   const test::Model hyper = test::make_model(s);
   const double hull = (n - 1) * (n - 1) * (n - 1) * voxel;
   EXPECT_NEAR(total_mass(hyper.elements), hull, 1e-12 * hull);
-  const ElementArrays::TissueMass& t = hyper.elements.tissue_mass.at(0);
+  const TissueMass t = tissue_masses(s, hyper.lattice, hyper.elements).at(0);
   EXPECT_TRUE(t.hull_body);
   EXPECT_NEAR(t.model_kg, hull, 1e-12 * hull);
   EXPECT_NEAR(t.hull_kg, hull, 1e-12 * hull);
@@ -49,7 +51,7 @@ TEST(LumpedMass, HyperelasticCubeCarriesTheHullOfItsCentresAndSpringsTheirVoxels
     const auto ijk = hyper.lattice.voxel_ijk(e);
     int outer = 0;
     for (const int c : ijk) outer += c == 0 || c == n - 1;
-    EXPECT_EQ(hyper.elements.volume_fraction[e], std::pow(0.5, outer));
+    EXPECT_EQ(mass_volume_fraction(hyper.lattice, hyper.elements, e), std::pow(0.5, outer));
     EXPECT_DOUBLE_EQ(hyper.elements.mass_kg[e], std::pow(0.5, outer) * voxel);
     EXPECT_DOUBLE_EQ(hyper.elements.inverse_mass[e], 1 / hyper.elements.mass_kg[e]);
   }
@@ -94,7 +96,7 @@ TEST(LumpedMass, OneVoxelSheetGetsTheFloorAndIsCounted) {
   s.materials["soft"].law = "neo-hookean";
   s.materials["soft"].poisson_ratio = 0.45;
   const test::Model m = test::make_model(s);
-  const ElementArrays::TissueMass& t = m.elements.tissue_mass.at(0);
+  const TissueMass t = tissue_masses(s, m.lattice, m.elements).at(0);
   EXPECT_EQ(t.floored, 36u);
   EXPECT_EQ(t.hull_kg, 0.0);
   EXPECT_NEAR(t.model_kg, 36 * kLeastVolumeFraction * kRho * kH * kH * kH, 1e-15);
@@ -128,7 +130,7 @@ double column_error(const std::string& law, bool swap_mass) {
   ElementArrays& el = model.elements;
   if (swap_mass)
     for (std::size_t e = 0; e < el.mass_kg.size(); ++e) {
-      const double w = law == "linear" ? dual_volume_fraction(model.lattice.neighbours(e)) : 1 / el.volume_fraction[e];
+      const double w = law == "linear" ? dual_volume_fraction(model.lattice.neighbours(e)) : 1 / mass_volume_fraction(model.lattice, el, e);
       el.mass_kg[e] *= w;
       if (el.inverse_mass[e] != 0) el.inverse_mass[e] /= w;
     }

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "engine/results/element_measures.hpp"
+#include "engine/sim/element_mass.hpp"
 #include "engine/sim/run.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
 
@@ -101,7 +102,7 @@ Hang hang(const Case& c, int n) {
   test::Model model = test::make_model(s);
   if (c.voxel_mass)
     for (std::size_t e = 0; e < model.lattice.element_count(); ++e) {
-      const double w = model.elements.volume_fraction[e];
+      const double w = mass_volume_fraction(model.lattice, model.elements, e);
       model.elements.mass_kg[e] /= w;
       model.elements.inverse_mass[e] *= w;
     }
