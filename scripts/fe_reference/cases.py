@@ -31,6 +31,11 @@ def solver_toml(precision, tol, max_steps):
             f"[stop]\nequilibrium = {tol!r}\nmax_steps = {max_steps}\n")
 
 
+def box_toml(size):
+    """A box from the origin to size on each axis: element centres at (n + 1/2) h inside it."""
+    return f"kind = \"box\"\nmin = [0, 0, 0]\nmax = {vec([size] * 3)}\n"
+
+
 def vec(v):
     return "[" + ", ".join(f"{x:.12g}" for x in v) + "]"
 
@@ -41,6 +46,18 @@ class Case:
     float_tol = 1e-5  # stop.equilibrium of float runs: above float's rounding floor (SCENE.md)
     float_min_h = 0.0  # float runs below this spacing (m) are not made (they stall at their floor)
     fe_body_depends_on_h = True
+
+    def scene_text(self, h, shape, law, precision, tol, max_steps, loads):
+        """A scene of one tissue: the shape's TOML lines, the material, the solver, then loads."""
+        return (f"[model]\nspacing = {h!r}\n\n[[model.shape]]\n{shape}label = \"tissue\"\n\n"
+                + material_toml("tissue", law, self.E, self.nu, self.rho)
+                + "\n" + solver_toml(precision, tol, max_steps) + "\n" + loads)
+
+    def held_under_gravity(self, gravity, anchor_point, anchor_normal, probe):
+        """Loads of the gravity cases: gravity, the held layer (a half-space), the probe."""
+        return (f"[gravity]\nvector = {vec(gravity)}\n\n"
+                f"[anchor.base]\nkind = \"halfspace\"\npoint = {vec(anchor_point)}\nnormal = {vec(anchor_normal)}\n\n"
+                f"[[track]]\nname = \"probe\"\npoint = {vec(probe)}\n")
 
     def fe_material(self, points):
         return np.zeros(len(points), dtype=int)
@@ -74,13 +91,8 @@ class CubeSag(Case):
     def scene(self, h, law, precision, tol, max_steps):
         n = self.n(h)
         c = n * h / 2
-        return (f"[model]\nspacing = {h!r}\n\n[[model.shape]]\nkind = \"box\"\nlabel = \"tissue\"\n"
-                f"min = [0, 0, 0]\nmax = {vec([n*h]*3)}\n\n"
-                + material_toml("tissue", law, self.E, self.nu, self.rho)
-                + "\n" + solver_toml(precision, tol, max_steps)
-                + f"\n[gravity]\nvector = [0, 0, {-self.g!r}]\n\n"
-                f"[anchor.base]\nkind = \"halfspace\"\npoint = {vec([0, 0, 0.75*h])}\nnormal = [0, 0, -1]\n\n"
-                f"[[track]]\nname = \"probe\"\npoint = {vec([c, c, (n-0.5)*h])}\n")
+        loads = self.held_under_gravity([0, 0, -self.g], [0, 0, 0.75 * h], [0, 0, -1], [c, c, (n - 0.5) * h])
+        return self.scene_text(h, box_toml(n * h), law, precision, tol, max_steps, loads)
 
     def from_summary(self, summary):
         return -summary["tracked"]["probe"]["displacement_m"][2] * 1e3
@@ -135,14 +147,9 @@ class Hemisphere(Case):
     def scene(self, h, law, precision, tol, max_steps):
         delta = 1e-4 * h  # the base layer and the rim lie exactly on the shape: keep them inside
         c = [0.5 * h, 0.5 * h, 0.5 * h + delta]
-        apex = self.probe(h)
-        return (f"[model]\nspacing = {h!r}\n\n[[model.shape]]\nkind = \"hemisphere\"\nlabel = \"tissue\"\n"
-                f"center = {vec(c)}\nradius = {self.R + 2*delta!r}\naxis = [0, 0, -1]\n\n"
-                + material_toml("tissue", law, self.E, self.nu, self.rho)
-                + "\n" + solver_toml(precision, tol, max_steps)
-                + f"\n[gravity]\nvector = {vec(self.gravity())}\n\n"
-                f"[anchor.base]\nkind = \"halfspace\"\npoint = {vec([0, 0, 0.25*h])}\nnormal = [0, 0, 1]\n\n"
-                f"[[track]]\nname = \"probe\"\npoint = {vec(apex)}\n")
+        shape = f"kind = \"hemisphere\"\ncenter = {vec(c)}\nradius = {self.R + 2*delta!r}\naxis = [0, 0, -1]\n"
+        loads = self.held_under_gravity(self.gravity(), [0, 0, 0.25 * h], [0, 0, 1], self.probe(h))
+        return self.scene_text(h, shape, law, precision, tol, max_steps, loads)
 
     def from_summary(self, summary):
         d = summary["tracked"]["probe"]["displacement_m"]
@@ -193,10 +200,7 @@ class ConfinedCompression(Case):
                 if axis == 2 and side == -1:
                     plates += f"velocity = [0, 0, {-self.eps*self.L/travel!r}]\ntravel_time = {travel!r}\n"
                 plates += "\n"
-        return (f"[model]\nspacing = {h!r}\n\n[[model.shape]]\nkind = \"box\"\nlabel = \"tissue\"\n"
-                f"min = [0, 0, 0]\nmax = {vec([n*h]*3)}\n\n"
-                + material_toml("tissue", law, self.E, self.nu, self.rho)
-                + "\n" + solver_toml(precision, tol, max_steps) + "\n" + plates)
+        return self.scene_text(h, box_toml(n * h), law, precision, tol, max_steps, plates)
 
     def from_summary(self, summary):
         return summary["indenters"][5]["reaction_force_n"][2] * 1e3
