@@ -1,17 +1,14 @@
 // Element masses (docs/PHYSICS.md, "Mass"): hyperelastic tissue carries the mass of the hull of
 // the element centres (each element its complete dual-cell octants, ⅛ of a voxel each), spring
 // tissue the mass of its voxels; mixed cells give each corner its own tissue's share; elements
-// with no complete dual cell get a floor and are counted. Then a column under self-weight against
-// the 1-D closed form u_top = ρgL²/(2E), each law with its own masses and with the other law's,
-// to show which mass matches each law's body.
+// with no complete dual cell get a floor and are counted. (Which mass matches each law's body:
+// ColumnSelfWeight.EachLawsOwnMassMatchesTheClosedFormBetter.)
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
-#include "engine/lattice/dual_cells.hpp"
 #include "engine/sim/element_mass.hpp"
-#include "engine/sim/run.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
 
 namespace vb {
@@ -104,64 +101,6 @@ TEST(LumpedMass, OneVoxelSheetGetsTheFloorAndIsCounted) {
     EXPECT_TRUE(std::isfinite(im));
     EXPECT_GT(im, 0);
   }
-}
-
-/// Top displacement of a 4 × 4 × 10 cm column (E = 1 MPa, strain ≈ 0.1%) on a held base layer at
-/// h = 5 mm, relative to ρgL²/(2E) (the geometry of ColumnSelfWeight). `swap_mass`: the other
-/// body's mass (a test-only change: hyperelastic elements get a whole voxel, spring elements
-/// their dual-volume share).
-double column_error(const std::string& law, bool swap_mass) {
-  const double h = 0.005, width = 0.04, length = 0.10, E = 1e6, g = 9.81;
-  const int nxy = int(std::lround(width / h)), nz = int(std::lround(length / h));
-  Scene s = test::box_scene(nxy, nxy, nz + 1, h, E);
-  s.model.shapes[0].min_m.z() = -h;
-  s.model.shapes[0].max_m.z() = length;
-  MaterialSpec& m = s.materials["soft"];
-  m.law = law;
-  if (law != "linear") m.poisson_ratio = 0;  // no lateral contraction: the column is exactly 1-D
-  s.anchors.push_back(test::halfspace_anchor("base", Vec3::Zero(), Vec3(0, 0, -1)));
-  s.gravity.active = true;
-  s.gravity.acceleration_m_s2 = Vec3(0, 0, -g);
-  s.solver.integrator = Integrator::Relaxation;
-  s.solver.precision = Precision::Double;
-  s.stop.equilibrium = 1e-8;
-  s.stop.max_steps = 100000;
-  test::Model model = test::make_model(s);
-  ElementArrays& el = model.elements;
-  if (swap_mass)
-    for (std::size_t e = 0; e < el.mass_kg.size(); ++e) {
-      const double w = law == "linear" ? dual_volume_fraction(model.lattice.neighbours(e)) : 1 / mass_volume_fraction(model.lattice, el, e);
-      el.mass_kg[e] *= w;
-      if (el.inverse_mass[e] != 0) el.inverse_mass[e] /= w;
-    }
-  Simulator sim(s, model.lattice, el, test::cl_context());
-  const RunOutput out = run_simulation(s, model.lattice, el, sim);
-  EXPECT_TRUE(out.summary.converged) << law << ": " << out.summary.stop_reason;
-  // The top layer's centres: the hull's top face; the spring body's runs h/2 higher, but its
-  // held layer is h/2 lower, so both bodies are `length` long between clamp and top.
-  double top = 0;
-  int count = 0;
-  for (std::size_t e = 0; e < model.lattice.element_count(); ++e)
-    if (model.lattice.rest_position(e).z() > length - h) top += out.state.displacement_m[3 * e + 2], ++count;
-  top /= count;
-  const double exact = -kRho * g * length * length / (2 * E);
-  return top / exact - 1;
-}
-
-TEST(LumpedMass, EachLawsOwnMassMatchesTheColumnClosedFormBetter) {
-  const double nh = column_error("neo-hookean", false), nh_voxel = column_error("neo-hookean", true);
-  const double lin = column_error("linear", false), lin_hull = column_error("linear", true);
-  std::printf("column sag error at h = 5 mm: neo-Hookean (ν 0) %+.2f%% (with voxel masses %+.2f%%); "
-              "linear springs %+.2f%% (with hull masses %+.2f%%)\n",
-              100 * nh, 100 * nh_voxel, 100 * lin, 100 * lin_hull);
-  RecordProperty("neo_hookean_error", std::to_string(nh));
-  RecordProperty("neo_hookean_voxel_mass_error", std::to_string(nh_voxel));
-  RecordProperty("linear_error", std::to_string(lin));
-  RecordProperty("linear_hull_mass_error", std::to_string(lin_hull));
-  EXPECT_LT(std::abs(nh), 0.02) << "hyperelastic body and mass are the hull";
-  EXPECT_GT(nh_voxel, 0.25) << "voxel masses overload the hull by (8/7)² × 21/20.5 ≈ 1.34";
-  EXPECT_LT(std::abs(lin), std::abs(lin_hull)) << "springs model the voxels: their mass is the voxels'";
-  EXPECT_LT(std::abs(lin), 0.10);
 }
 
 }  // namespace

@@ -80,7 +80,8 @@ TEST_P(RestOffsets, AnAffineRestStateIsForceFree) {
 INSTANTIATE_TEST_SUITE_P(Laws, RestOffsets, ::testing::Values("linear", "biphasic", "neo-hookean", "ogden"), law_name);
 
 /// A 5×5×8 column (E = 30 kPa) standing on a held base, leaning and sagging under gravity along
-/// x and −z in the CT (about 6 mm at the top with the CT as rest).
+/// x and −z in the CT (at the top with the CT as rest: 1.8 mm with springs, 1.7 mm neo-Hookean,
+/// 0.64 mm Ogden; the hyperelastic columns' hull masses weigh (4/5)²·6.5/7 of the voxels').
 Scene ct_column(const std::string& law) {
   const double h = 0.004;
   Scene s = test::box_scene(5, 5, 8, h, 30000);
@@ -126,7 +127,7 @@ TEST_P(ReferenceStateColumn, LoadedByTheCtsGravityItLandsOnTheCt) {
   EXPECT_LT(largest_norm(run.state.displacement_m), 2 * s.reference_state.tolerance_m);
 
   // The unloaded column is the CT with the sag undone: about minus the sag the CT would show as
-  // rest (the same to first order in the strain, ~1 %; the sag here is ~6 mm on 32 mm).
+  // rest (the same to first order in the strain, ~1 %; the sag here is 0.6–1.8 mm on 32 mm).
   Scene ct_as_rest = s;
   ct_as_rest.reference_state = ReferenceStateSpec{};
   Simulator plain(ct_as_rest, m.lattice, m.elements, cl_context());
@@ -136,7 +137,7 @@ TEST_P(ReferenceStateColumn, LoadedByTheCtsGravityItLandsOnTheCt) {
   const double sag_m = largest_norm(sag.state.displacement_m);
   std::cout << "  sag with the CT as rest " << sag_m * 1e3 << " mm; |u0 + sag| up to " << largest_norm(mirror) * 1e3
             << " mm\n";
-  EXPECT_GT(sag_m, 1e-3);
+  EXPECT_GT(sag_m, 0.5e-3);  // a load the comparisons below can resolve (0.15 × sag ≫ tolerance)
   EXPECT_NEAR(ref.max_rest_offset_m, sag_m, 0.15 * sag_m);
   EXPECT_LT(largest_norm(mirror), 0.15 * sag_m);
 }

@@ -239,14 +239,12 @@ TEST(SelfWeightConvergence, LinearSpringsDepartFromNeoHookeanMoreAtLargeLoad) {
 }
 
 // The small-strain limit: neo-Hookean at ν = 1/4 against linear springs on the same lattice and
-// load (gravity × 0.003, 0.07% strain on the axis), both with voxel masses. At one spacing they
+// load (gravity × 0.003, 0.07% strain on the axis), each with its own masses. At one spacing they
 // differ by O(h): the springs' body is close to the voxel body (n·h across, clamped at the held
-// centres, so h/2 longer), the neo-Hookean body is the hull ((n − 1)·h) carrying the voxel mass.
-// So the difference must halve with h, and the two fields, each extrapolated to h → 0 from
-// h = 3 and 1.5 mm (first order), must agree: relative RMS difference over the coarse nodes < 3%,
-// free-face centre < 1.5%. What remains (2.0%, −0.8%) is the two-level extrapolation of the
-// neo-Hookean sequence, not yet at its asymptotic order at 3 mm (1.15, then 1.07, 1.04); the long
-// study, extrapolating with the order observed on 1.5, 0.75 and 0.375 mm, finds −0.19%.
+// centres, so h/2 longer) with voxel masses, the neo-Hookean body is the hull ((n − 1)·h) with
+// hull masses. So the difference must halve with h, and the two fields, each extrapolated to
+// h → 0 from h = 3 and 1.5 mm (first order), must agree: relative RMS difference over the coarse
+// nodes < 3%, free-face centre < 1.5% (measured 0.87%, −0.29%).
 TEST(SelfWeightConvergence, SmallStrainNeoHookeanMatchesLinearSprings) {
   Case nh{"neo-hookean", 0.25, kTinyLoad, false}, lin{"linear", 0.25, kTinyLoad, false};
   const Hang nh11 = hang(nh, 11), nh21 = hang(nh, 21);
