@@ -5,7 +5,6 @@ positions n (centre (n + 1/2) h), so the FE body, the union of the dual cells of
 is exactly VoxBreast's elastic body for hyperelastic tissue, and the held layer of centres is the
 FE's held face.
 """
-import math
 
 import numpy as np
 
