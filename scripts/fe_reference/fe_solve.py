@@ -102,7 +102,6 @@ def solve(body, materials, material_of, gravity, rho_of, fixed, sliding, probes,
 
     V, _ = W.sub(0).collapse()
     bcs, moving = [], []
-    fdim = msh.topology.dim - 1
     if fixed is not None:
         zero = fem.Function(V)
         dofs = fem.locate_dofs_geometrical((W.sub(0), V), fixed)
@@ -192,7 +191,7 @@ def solve(body, materials, material_of, gravity, rho_of, fixed, sliding, probes,
     if reactions:
         # Reaction = residual of the unconstrained problem at the solution on the held dofs.
         for name, (marker, comp) in reactions.items():
-            Vc, sub_to_W = W.sub(0).sub(comp).collapse()
+            Vc, _ = W.sub(0).sub(comp).collapse()
             dofs = fem.locate_dofs_geometrical((W.sub(0).sub(comp), Vc), marker)[0]
             out[name] = float(-arr[dofs].sum())
     out["fe_time_s"] = time.time() - t0
