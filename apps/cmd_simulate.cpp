@@ -81,7 +81,10 @@ int run_simulate(const SimulateOptions& o) {
   if (report.mesh_outputs)
     std::printf("wrote surface meshes (.vtp, .stl, .ply)%s and lattice.vtu in %s/\n",
                 scene.tori.empty() ? "" : ", device meshes", o.out.c_str());
-  return 0;
+  if (report.unconverged.empty()) return 0;
+  std::fprintf(stderr, "voxbreast: the result is not converged (see the warnings above and summary.json); exit status %d\n",
+               kExitNotConverged);
+  return kExitNotConverged;
 }
 
 }  // namespace
