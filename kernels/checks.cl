@@ -179,10 +179,10 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_KERNEL
         for (int i = 0; i < VB_TORI; ++i) torus_check(&f, xt, indenters, i, t_force, h, area, value);
       }
 #endif
-      const real2 scale = check_scale[e];
-      value[0] = length(xyz0(f)) * scale.x;
+      const real2 own_scale = check_scale[e];
+      value[0] = length(xyz0(f)) * own_scale.x;
       value[2] = (real)0.5 * dot3(vi, vi) / ui.w;
-      value[5] = value[1] * scale.y;
+      value[5] = value[1] * own_scale.y;
     }
   }
   for (int k = 0; k < VB_CHECK_SLOTS; ++k) s[k][l] = value[k];

@@ -118,8 +118,8 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   hyper_ = el.hyperelastic;
   biphasic_ = el.biphasic;
   plan_launches(scene, el, cl);
-  if (stress_pair_) device_bytes_ += n_ * 4 * 4 * real_size_;
-  device_bytes_ += 2 * n_ * real_size_;  // the check's per-element scales  // the predicted stage's Q rows and C
+  if (stress_pair_) device_bytes_ += n_ * 4 * 4 * real_size_;  // the predicted stage's Q rows and C
+  device_bytes_ += 2 * n_ * real_size_;  // the check's per-element scales
   require_fits_device(device_bytes_, n_, cells, el.hyperelastic, scene, cl.info);
 
   const PaddedGrid padded = make_padded_grid(lattice);
