@@ -5,9 +5,9 @@
 //   2 kinetic energy (J)                               3 max |u| (m)
 //   4 non-finite elements                              5 max speed ratio |v|/√(E/ρ)
 //   6 + 4i .. 8 + 4i  force of the tissue on indenter i (N), 9 + 4i  its contact elements
-// The ratios scale each element by its own modulus, or a stiffer free neighbour's (check_scale:
-// 1/(E·h²), 1/√(E/ρ) per element), so the equilibrium test holds for every tissue, not only for
-// the stiffest (docs/SCENE.md, "Equilibrium criterion").
+// The ratios scale each element by its own modulus, or a stiffer hyperelastic neighbour's
+// (check_scale: 1/(E·h²), 1/√(E/ρ) per element), so the equilibrium test holds for every tissue,
+// not only for the stiffest (docs/SCENE.md, "Equilibrium criterion").
 // `partial_arg` holds, per group, the element with the largest speed (first non-finite wins).
 // With VB_VOLUME the residual is that of the constrained problem: the pressure term p·g
 // (kernels/volume.cl, computed just before) is taken off the static force of surface elements.

@@ -40,7 +40,7 @@ EquilibriumScales equilibrium_scales(const Lattice& lattice, const ElementArrays
 
 /// Whether check c meets the equilibrium criterion at tolerance tol: every free element's residual
 /// force ≤ tol·E·h² and, for the dynamic integrators, its speed ≤ tol·√(E/ρ), E the largest
-/// modulus of the element and its free neighbours (StateCheck's ratios); for relaxation, whose
+/// modulus of the element and its free hyperelastic neighbours (StateCheck's ratios); for relaxation, whose
 /// speeds are fictitious, the distance still to go, max speed / ω_min ≤ tol·L instead (its slowest
 /// mode decays as e^(−ω_min·t); docs/PHYSICS.md, "Fast equilibrium"). Runs, probe presses, force
 /// curves and fit solves stop on it.

@@ -601,16 +601,22 @@ std::vector<unsigned char> Simulator::real_bytes(const std::vector<double>& valu
 
 void Simulator::write_check_scale(const ElementArrays& el) {
   // Each element's residual and speed over its own scales, E·h² and √(E/ρ), E the largest modulus
-  // of the element and its free neighbours: the forces on it come from them, so round-off in a
-  // stiff neighbour's stress (float: ~1e-7 of it) must not hold a soft element above the test,
-  // while one element further the soft tissue's own scale applies (docs/PHYSICS.md, section 9).
+  // of the element and its free hyperelastic neighbours: their stress acts on it, so round-off in
+  // a stiff neighbour's stress (float: ~1e-7 of it) must not hold a soft element above the test,
+  // while one element further the soft tissue's own scale applies. A spring neighbour acts through
+  // the connection's series stiffness, at most twice the element's own (docs/PHYSICS.md, section 9).
   // 1e300 (float: saturated) where E is not positive, so such an element never passes.
+  const auto hyperelastic = [&](std::size_t e) {  // the kernels' law ids 1 and 2
+    const double law = el.material_table.empty() ? 0 : el.material_table[lattice_.tissue_of_element[e]][0];
+    return law == 1 || law == 2;
+  };
   const double h = lattice_.spacing_m;
   std::vector<double> scale(2 * n_, 1e300);
   for (std::size_t e = 0; e < n_; ++e) {
     double E = el.youngs_modulus_pa[e];
     for (const std::int32_t j : lattice_.neighbours(e))
-      if (j >= 0 && el.inverse_mass[std::size_t(j)] != 0) E = std::max(E, el.youngs_modulus_pa[std::size_t(j)]);
+      if (j >= 0 && el.inverse_mass[std::size_t(j)] != 0 && hyperelastic(std::size_t(j)))
+        E = std::max(E, el.youngs_modulus_pa[std::size_t(j)]);
     const double rho = el.mass_kg[e] / (h * h * h);
     if (!(E > 0) || !(rho > 0)) continue;
     scale[2 * e] = std::min(1e300, 1 / (E * h * h));

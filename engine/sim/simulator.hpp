@@ -52,7 +52,7 @@ struct IndenterMotion {
 /// Device-side reductions over the current state (see kernels/checks.cl).
 struct StateCheck {
   /// largest net static force on a free element over its E·h², E the largest modulus of the
-  /// element and its free neighbours (dimensionless)
+  /// element and its free hyperelastic neighbours (dimensionless)
   double residual_ratio = 0;
   double max_speed_m_s = 0;       ///< +inf when some value is not finite
   /// largest speed of a free element over its wave speed √(E/ρ), E as above (dimensionless)
