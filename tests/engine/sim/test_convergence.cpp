@@ -10,6 +10,7 @@
 #include <cstdio>
 
 #include "engine/error.hpp"
+#include "engine/sim/instability.hpp"
 #include "engine/sim/run.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
 
