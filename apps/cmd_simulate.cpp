@@ -56,7 +56,10 @@ int run_simulate(const SimulateOptions& o) {
 
   const RunSummary& s = report.summary;
   std::printf("%s after %lld steps (%.4g s simulated, %.1f s wall, %.0f steps/s); max displacement %.3f mm\n",
-              s.converged ? "equilibrium reached" : ("stopped at " + s.stop_reason).c_str(), (long long)s.steps,
+              s.converged                       ? "equilibrium reached"
+              : s.stop_reason == "equilibrium" ? "equilibrium met only trivially"
+                                                : ("stopped at " + s.stop_reason).c_str(),
+              (long long)s.steps,
               s.simulated_time_s, s.wall_time_s, s.steps_per_second, 1e3 * s.max_displacement_m);
   for (const std::string& w : report.warnings) std::fprintf(stderr, "voxbreast: warning: %s\n", w.c_str());
   for (const TorusResult& t : s.tori)
