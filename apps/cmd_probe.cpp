@@ -40,6 +40,8 @@ int run_probe(const ProbeOptions& o) {
   for (std::size_t k = 0; k < r.presses.size(); ++k)
     std::printf("press %zu at %.2f mm: force %.4g N at %.3g mm, stiffness %.4g N/mm\n", k + 1, 1e3 * r.presses[k].position_m,
                 r.presses[k].peak_force_n, 1e3 * scene.probe.depth_m, 1e-3 * r.presses[k].stiffness_n_m);
+  if (!r.settled)
+    std::fprintf(stderr, "voxbreast: warning: settling under gravity stopped at stop.max_steps before equilibrium\n");
   if (r.unconverged_increments > 0)
     std::fprintf(stderr, "voxbreast: warning: %lld increments stopped at stop.max_steps before equilibrium\n",
                  (long long)r.unconverged_increments);
@@ -51,7 +53,11 @@ int run_probe(const ProbeOptions& o) {
                    k + 1, r.presses[k].min_det_f);
   std::printf("%lld steps in %.1f s\nwrote %s/probe_curves.csv, probe_profile.csv, probe_summary.json\n",
               (long long)r.total_steps, r.wall_time_s, o.out.c_str());
-  return 0;
+  // Without an equilibrium test every increment runs its steps, as asked.
+  if (!(scene.stop.equilibrium > 0) || (r.settled && r.unconverged_increments == 0)) return 0;
+  std::fprintf(stderr, "voxbreast: the curves are not converged (see the warnings above); exit status %d\n",
+               kExitNotConverged);
+  return kExitNotConverged;
 }
 
 }  // namespace

@@ -56,7 +56,10 @@ int run_simulate(const SimulateOptions& o) {
 
   const RunSummary& s = report.summary;
   std::printf("%s after %lld steps (%.4g s simulated, %.1f s wall, %.0f steps/s); max displacement %.3f mm\n",
-              s.converged ? "equilibrium reached" : ("stopped at " + s.stop_reason).c_str(), (long long)s.steps,
+              s.converged                       ? "equilibrium reached"
+              : s.stop_reason == "equilibrium" ? "equilibrium met only trivially"
+                                                : ("stopped at " + s.stop_reason).c_str(),
+              (long long)s.steps,
               s.simulated_time_s, s.wall_time_s, s.steps_per_second, 1e3 * s.max_displacement_m);
   for (const std::string& w : report.warnings) std::fprintf(stderr, "voxbreast: warning: %s\n", w.c_str());
   for (const TorusResult& t : s.tori)
@@ -90,7 +93,10 @@ int run_simulate(const SimulateOptions& o) {
   if (report.mesh_outputs)
     std::printf("wrote surface meshes (.vtp, .stl, .ply)%s and lattice.vtu in %s/\n",
                 scene.tori.empty() ? "" : ", device meshes", o.out.c_str());
-  return 0;
+  if (report.unconverged.empty()) return 0;
+  std::fprintf(stderr, "voxbreast: the result is not converged (see the warnings above and summary.json); exit status %d\n",
+               kExitNotConverged);
+  return kExitNotConverged;
 }
 
 }  // namespace

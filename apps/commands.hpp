@@ -5,6 +5,11 @@
 
 namespace vb::app {
 
+/// Exit statuses besides 0 (done as asked), 1 (an error) and 2 (a misused command line):
+/// a result that is not converged (written, and flagged in its summary), and a run that went
+/// unstable (nothing written). README.md, "Exit status".
+inline constexpr int kExitNotConverged = 3, kExitUnstable = 4;
+
 /// A registered subcommand and what runs it (after parsing); run returns the exit code.
 struct Command {
   CLI::App* sub = nullptr;

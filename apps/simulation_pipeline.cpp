@@ -70,13 +70,14 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
   SimulationReport report;
   report.summary = result.summary;
   report.warnings = model.warnings;
+  if (!result.summary.unconverged_reason.empty()) report.unconverged.push_back(result.summary.unconverged_reason);
   if (auto hint = float_floor_hint(scene, result.summary)) report.warnings.push_back(*hint);
   if (reference && !reference->converged) {
     char text[200];
     std::snprintf(text, sizeof text,
                   "the unloaded reference state is %.3g mm from the CT after %zu iterations (tolerance %.3g mm)",
                   1e3 * reference->residual_max_m, reference->history.size(), 1e3 * scene.reference_state.tolerance_m);
-    report.warnings.push_back(text);
+    report.unconverged.push_back(text);
   }
   io.lock();
   nlohmann::json summary = summary_to_json(result.summary, scene);
@@ -90,7 +91,8 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
   }
   report.positioning.reproducibility = repro;
   if (repro)
-    if (auto unsettled = unsettled_runs_warning(*repro)) report.warnings.push_back(*unsettled);
+    if (auto unsettled = unsettled_runs_warning(*repro)) report.unconverged.push_back(*unsettled);
+  report.warnings.insert(report.warnings.end(), report.unconverged.begin(), report.unconverged.end());
   summary["positioning"] = positioning_to_json(report.positioning);
   if (repro) summary["positioning"]["reproducibility"] = reproducibility_to_json(*repro, scene.reproducibility);
   write_metrics_csv(out_dir + "/metrics.csv", result.summary, report.positioning);

@@ -30,6 +30,9 @@ struct SimulationReport {
   PositioningMetrics positioning;  ///< tumour, chest wall, device contact, comfort (docs/POSITIONING.md)
   RunSummary summary;
   std::vector<std::string> warnings;  ///< e.g. DICOM slice gaps accepted with allow_gaps
+  /// Why the result is not a converged one (the run, the unloaded reference state, perturbed
+  /// runs); each is among the warnings too. Empty: converged, or a fixed run as asked.
+  std::vector<std::string> unconverged;
   bool image_outputs = false;         ///< DVF, warped CT and fields written (CT models)
   bool mesh_outputs = false;          ///< surface meshes and lattice written
 };

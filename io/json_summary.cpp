@@ -180,6 +180,7 @@ json summary_to_json(const RunSummary& s, const Scene& scene) {
       {"steps_per_second", number(s.steps_per_second)},
       {"converged", s.converged},
       {"stop_reason", s.stop_reason},
+      {"unconverged_reason", s.unconverged_reason.empty() ? nlohmann::json() : nlohmann::json(s.unconverged_reason)},
       {"final_residual", number(s.final_residual)},
       {"final_speed_ratio", number(s.final_speed_ratio)},
       {"max_displacement_m", number(s.max_displacement_m)},

@@ -182,6 +182,11 @@ MaterialSpec read_material(const std::string& name, const Section& s) {
   m.rigid = s.boolean("rigid").value_or(m.rigid);
   const std::optional<double> E = s.positive("E");
   if (m.law_takes_E() && !E && !fallback && !m.rigid) s.fail("E", "missing required key", "'" + name + "' has no default material");
+  // Beyond any material, and beyond what float forces (E·h² and its products) can hold.
+  constexpr double kStiffestModulus = 1e13;
+  if (E && *E > kStiffestModulus)
+    s.fail("E", "must be at most " + format_number(kStiffestModulus) + " Pa, got " + format_number(*E),
+           "E is in Pa: the stiffest material, diamond, has 1.2e12 Pa; for tissue that does not move, use rigid = true");
   m.youngs_modulus_pa = E.value_or(fallback ? fallback->youngs_modulus_pa : m.rigid ? 1e12 : 0.0);
   if (const std::optional<double> rho = s.positive("density")) {
     // Tissue lies near 1000 kg/m³; below 10 it is g/cm³ (or t/m³) written where kg/m³ belongs.
@@ -206,11 +211,22 @@ MaterialSpec read_material(const std::string& name, const Section& s) {
       s.fail("critical_strain", "must be in (0, 1), got " + format_number(m.critical_strain), "e.g. 0.1");
   }
   if (m.law != "linear" && m.law != "biphasic" && !m.rigid) {
+    std::string unstable;
     try {
-      (void)law_of(m);  // parameters that make no material fail here, at their line
+      unstable = unstable_range(law_of(m));  // parameters that make no material fail here, at their line
     } catch (const Error& e) {
       const std::string key = e.location().substr(e.location().rfind('.') + 1);
       s.fail(s.find(key) ? key : "law", e.problem(), e.hint());
+    }
+    if (!unstable.empty()) {
+      // A law that softens within tissue's strains has no stable equilibrium there: runs of it
+      // blow up whatever the time step.
+      const bool mr = m.law == "mooney-rivlin";
+      s.fail(mr ? "c01" : "mu",
+             "these " + m.law + " parameters are not stable (their stiffness is not positive definite): the stress "
+             "stops rising with the strain " + unstable,
+             mr ? "keep c01 >= 0, or small against c10 (the law softens in compression when c10 + c01/stretch < 0)"
+                : "give every term mu*alpha > 0");
     }
   }
   return m;

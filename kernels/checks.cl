@@ -1,10 +1,13 @@
 // State check, run every `check_every` steps (never every step): per work-group reductions the
-// host finishes. Slots of `partial` per group (VB_CHECK_SLOTS = 5 + 4·VB_INDENTERS + 8·VB_TORI
+// host finishes. Slots of `partial` per group (VB_CHECK_SLOTS = 6 + 4·VB_INDENTERS + 8·VB_TORI
 // + 4·VB_RELAX reals):
-//   0 max residual force |F| on free elements (N)   1 max speed (m/s; +inf if non-finite)
-//   2 kinetic energy (J)                            3 max |u| (m)
-//   4 non-finite elements
-//   5 + 4i .. 7 + 4i  force of the tissue on indenter i (N), 8 + 4i  its contact elements
+//   0 max residual ratio |F|/(E·h²) on free elements  1 max speed (m/s; +inf if non-finite)
+//   2 kinetic energy (J)                               3 max |u| (m)
+//   4 non-finite elements                              5 max speed ratio |v|/√(E/ρ)
+//   6 + 4i .. 8 + 4i  force of the tissue on indenter i (N), 9 + 4i  its contact elements
+// The ratios scale each element by its own modulus, or a stiffer hyperelastic neighbour's
+// (check_scale: 1/(E·h²), 1/√(E/ρ) per element), so the equilibrium test holds for every tissue,
+// not only for the stiffest (docs/SCENE.md, "Equilibrium criterion").
 // `partial_arg` holds, per group, the element with the largest speed (first non-finite wins).
 // With VB_VOLUME the residual is that of the constrained problem: the pressure term p·g
 // (kernels/volume.cl, computed just before) is taken off the static force of surface elements.
@@ -23,14 +26,15 @@
 //   R     uᵀKu = −Σ u·f_lattice(u)          R + 1  uᵀM̃u = Σ m̃|u|²
 //   R + 2 ΔuᵀKΔu = −Σ Δu·Δf_lattice         R + 3  ΔuᵀM̃Δu = Σ m̃|Δu|²
 // (J and kg·m²; exact for linear springs, secant/tangent-like for the other laws).
-#define VB_TORUS_SLOT0 (5 + 4 * VB_INDENTERS)
+#define VB_IND_SLOT0 6
+#define VB_TORUS_SLOT0 (VB_IND_SLOT0 + 4 * VB_INDENTERS)
 #define VB_TORUS_SLOTS 8
 #define VB_RELAX_SLOT0 (VB_TORUS_SLOT0 + VB_TORUS_SLOTS * VB_TORI)
 #if VB_TORI
-#define VB_SLOT_SUM(s) ((s) == 2 || ((s) >= 4 && ((s) < VB_TORUS_SLOT0 || (s) >= VB_RELAX_SLOT0 || \
+#define VB_SLOT_SUM(s) ((s) == 2 || (s) == 4 || ((s) > 5 && ((s) < VB_TORUS_SLOT0 || (s) >= VB_RELAX_SLOT0 || \
                                                   ((s) - VB_TORUS_SLOT0) % VB_TORUS_SLOTS < 6)))
 #else
-#define VB_SLOT_SUM(s) ((s) == 2 || (s) >= 4)
+#define VB_SLOT_SUM(s) ((s) == 2 || (s) == 4 || (s) > 5)
 #endif
 
 #if VB_TORI
@@ -61,7 +65,8 @@ VB_INLINE void torus_check(real4* f, real4 x, global const real* table, int i, r
 
 kernel __attribute__((reqd_work_group_size(VB_CHECK_WG, 1, 1)))
 void check_state(global const real4* u, global const real4* v, VB_LATTICE_KERNEL_PARAMS,
-                 VB_INDENTER_PARAMS, global real* partial, global int* partial_arg, uint n
+                 VB_INDENTER_PARAMS, global real* partial, global int* partial_arg, uint n,
+                 global const real2* check_scale  // per element: 1/(E·h²) (1/N), 1/√(E/ρ) (s/m)
 #if VB_VOLUME
                  , global const real4* volume_grad, global const real* volume_scalars
 #endif
@@ -141,10 +146,10 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_KERNEL
         if (fn > 0 && mu > 0)
           reaction += friction_carried(&f, pushed / fn, fn, mu, vi - indenter_velocity(ind, t_force), slip_per_n * mu * fn);
 #endif
-        value[5 + 4 * i] = reaction.x;
-        value[6 + 4 * i] = reaction.y;
-        value[7 + 4 * i] = reaction.z;
-        value[8 + 4 * i] = dot3(pushed, pushed) > 0 ? 1 : 0;
+        value[VB_IND_SLOT0 + 4 * i] = reaction.x;
+        value[VB_IND_SLOT0 + 1 + 4 * i] = reaction.y;
+        value[VB_IND_SLOT0 + 2 + 4 * i] = reaction.z;
+        value[VB_IND_SLOT0 + 3 + 4 * i] = dot3(pushed, pushed) > 0 ? 1 : 0;
       }
 #endif
 #if VB_INDENTERS
@@ -161,10 +166,10 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_KERNEL
           reaction += friction_carried(&f, grip.normal, length(xyz0(reaction)), indenters[VB_IND_STRIDE * i + 17],
                                        vi - grip.surface_v, slip_per_n * grip.grip_n);
 #endif
-        value[5 + 4 * i] = reaction.x;
-        value[6 + 4 * i] = reaction.y;
-        value[7 + 4 * i] = reaction.z;
-        value[8 + 4 * i] = dot3(reaction, reaction) > 0 ? 1 : 0;
+        value[VB_IND_SLOT0 + 4 * i] = reaction.x;
+        value[VB_IND_SLOT0 + 1 + 4 * i] = reaction.y;
+        value[VB_IND_SLOT0 + 2 + 4 * i] = reaction.z;
+        value[VB_IND_SLOT0 + 3 + 4 * i] = dot3(reaction, reaction) > 0 ? 1 : 0;
       }
 #endif
 #if VB_TORI
@@ -174,8 +179,10 @@ void check_state(global const real4* u, global const real4* v, VB_LATTICE_KERNEL
         for (int i = 0; i < VB_TORI; ++i) torus_check(&f, xt, indenters, i, t_force, h, area, value);
       }
 #endif
-      value[0] = length(xyz0(f));
+      const real2 own_scale = check_scale[e];
+      value[0] = length(xyz0(f)) * own_scale.x;
       value[2] = (real)0.5 * dot3(vi, vi) / ui.w;
+      value[5] = value[1] * own_scale.y;
     }
   }
   for (int k = 0; k < VB_CHECK_SLOTS; ++k) s[k][l] = value[k];

@@ -20,7 +20,6 @@ std::vector<double> press_curve_forces(const Scene& scene_in, const Lattice& lat
   const double h = lattice.spacing_m, tol = scene.stop.equilibrium;
   require(tol > 0, "a force curve needs an equilibrium tolerance", "stop.equilibrium", "set it, e.g. 1e-7");
   const EquilibriumScales scales = equilibrium_scales(lattice, elements);
-  const double F_ref = scales.force_n;
   const std::int64_t check_every = std::max(1, scene.solver.check_every);
   const std::int64_t max_steps = o.max_steps_per_level > 0 ? o.max_steps_per_level : scene.stop.max_steps;
 
@@ -48,7 +47,7 @@ std::vector<double> press_curve_forces(const Scene& scene_in, const Lattice& lat
       }
       require(sim.steps() - level_start < max_steps,
               "no equilibrium at a travel of " + std::to_string(1e3 * d) + " mm after " + std::to_string(max_steps) +
-                  " steps (residual " + std::to_string(c.max_residual_n / F_ref) + ")",
+                  " steps (residual " + std::to_string(c.residual_ratio) + ")",
               "stop.equilibrium", "loosen the tolerance, raise stop.max_steps, or check the anchors hold the model");
     }
     previous = d;

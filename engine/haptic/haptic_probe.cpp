@@ -136,7 +136,7 @@ bool HapticProbe::update() {
     last_.force_n = force;
     last_.stiffness_n_m = K_;
     last_.contact_elements = c.contact_elements[options_.probe];
-    last_.residual = c.max_residual_n / F_ref_;
+    last_.residual = c.residual_ratio;
     last_.steps = sim_.steps();
     first_check = last_.fold_checks == 0;
   }

@@ -94,6 +94,24 @@ HyperelasticLaw law_of(const MaterialSpec& m) {
   throw Error("law '" + m.law + "' is not hyperelastic", "materials." + m.name + ".law");
 }
 
+std::string unstable_range(const HyperelasticLaw& law) {
+  // Forward differences on a fine grid, relative to the small-strain modulus 3μ₀ (uniaxial) and
+  // μ₀ (shear), so round-off near λ = 1 does not count as softening.
+  const double mu0 = law.shear_modulus_pa();
+  constexpr int kSamples = 600;
+  for (int i = 0; i < kSamples; ++i) {
+    const double a = 0.5 + 1.5 * i / kSamples, b = 0.5 + 1.5 * (i + 1) / kSamples;
+    if (!((uniaxial_nominal_stress(law, b) - uniaxial_nominal_stress(law, a)) / (b - a) > 1e-9 * 3 * mu0))
+      return "in uniaxial stress at stretch " + std::to_string(a).substr(0, 5);
+  }
+  for (int i = 0; i < kSamples; ++i) {
+    const double a = double(i) / kSamples, b = double(i + 1) / kSamples;
+    if (!((simple_shear_stress(law, b) - simple_shear_stress(law, a)) / (b - a) > 1e-9 * mu0))
+      return "in simple shear at shear amount " + std::to_string(a).substr(0, 5);
+  }
+  return "";
+}
+
 namespace {
 
 /// Principal stretches λ_i and material directions N_i (columns) of C = FᵀF.

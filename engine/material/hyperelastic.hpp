@@ -54,4 +54,11 @@ double uniaxial_nominal_stress(const HyperelasticLaw& law, double stretch);
 /// principal stretches of F = I + γ e1⊗e2 (exact for every Ogden law).
 double simple_shear_stress(const HyperelasticLaw& law, double gamma);
 
+/// Where the law stops being stable in Drucker's sense within tissue's range, as words ("in
+/// uniaxial stress at stretch 0.9"): the first uniaxial stretch λ ∈ [0.5, 2] at which the nominal
+/// stress does not rise with λ, or the first shear amount γ ∈ [0, 1] at which the shear stress does
+/// not rise with γ; empty when it is stable throughout. Neo-Hookean, and Mooney-Rivlin and Ogden
+/// with C01 ≥ 0 and every μ_p·α_p > 0, always are.
+std::string unstable_range(const HyperelasticLaw& law);
+
 }  // namespace vb

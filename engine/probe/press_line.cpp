@@ -47,7 +47,7 @@ Relaxed relax(const Scene& scene, const Lattice& lattice, const ElementArrays& e
     if (r.check.nonfinite_elements > 0 || !std::isfinite(r.check.max_speed_m_s))
       throw Error("probing went unstable: " + std::to_string(r.check.nonfinite_elements) + " elements have non-finite state",
                   "solver", "use a smaller solver.dt or smaller probe increments (more [probe] steps)");
-    r.residual = r.check.max_residual_n / scales.force_n;
+    r.residual = r.check.residual_ratio;
     if (at_equilibrium(sim, r.check, scales, tol) && r.steps >= min_steps) {
       r.converged = true;
       break;

@@ -20,7 +20,7 @@ inline constexpr std::size_t kSplitWorkGroup = 128, kSplitMaxElements = 98304;
 inline constexpr std::size_t kPersistentMaxElements = 45056;
 // VB_LANE_WIDTH (kernels/integrate_lanes.cl): free elements per work-item of the CPU lanes kernels
 inline constexpr std::size_t kLaneWidth = 8;
-inline constexpr int kCheckBaseSlots = 5, kCheckSlotsPerIndenter = 4;  // kernels/checks.cl
+inline constexpr int kCheckBaseSlots = 6, kCheckSlotsPerIndenter = 4;  // kernels/checks.cl
 inline constexpr int kCheckSlotsPerTorus = 8;                             // VB_TORUS_SLOTS
 inline constexpr int kIndenterStride = 20;                                // VB_IND_STRIDE
 inline constexpr int kTorusStride = 12;                                   // VB_TORUS_STRIDE
@@ -30,11 +30,11 @@ inline constexpr int kLatticeArgs = 10, kLatticeGravity = 6, kIndenterArgs = 3;
 inline constexpr int kStepLattice = 4;  // step kernels: the 4 state arrays' offsets first (the state arena last)
 inline constexpr int kStepIndenter = kStepLattice + kLatticeArgs;   // then dt, n
 inline constexpr int kCheckLattice = 2;                             // check_state: u, v first
-inline constexpr int kCheckIndenter = kCheckLattice + kLatticeArgs; // then partial, partial_arg, n
+inline constexpr int kCheckIndenter = kCheckLattice + kLatticeArgs; // then partial, partial_arg, n, scale
 // With VB_TRI_CONTACT the stepping and check kernels end with VB_TRI_PARAMS
 // (kernels/triangle_contact.cl): corner forces, CSR start, corners, triangle count.
 inline constexpr int kTriangleArgs = 4;
-inline constexpr int kCheckVolume = kCheckIndenter + kIndenterArgs + 3;  // VB_VOLUME: grad, scalars
+inline constexpr int kCheckVolume = kCheckIndenter + kIndenterArgs + 4;  // VB_VOLUME: grad, scalars
 // kernels/volume.cl: volume_partials takes u, v, the lattice parameters, then these.
 inline constexpr int kVolumeSlots = 5, kVolumeScalars = 5;  // scalars: λ, μ, V, p, M (kernels/volume.cl)
 inline constexpr int kVolumeMesh = 2 + kLatticeArgs;  // mesh arena, its offsets, n_surf

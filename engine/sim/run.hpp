@@ -28,16 +28,19 @@ struct RunOutput {
 RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const ElementArrays& elements,
                          Simulator& sim, const std::function<void(const RunProgress&)>& progress = {});
 
-/// The scales of the equilibrium criterion (docs/SCENE.md, "Equilibrium criterion").
+/// Model-wide scales (docs/SCENE.md, "Equilibrium criterion"). The residual and speed tests scale
+/// each element by its own tissue on the device (StateCheck's ratios); these are the stiffest free
+/// tissue's, for bounds such as the haptic probe's stiffness, and the size relaxation's test uses.
 struct EquilibriumScales {
-  double force_n = 0;         ///< F_ref = E_max·h²
-  double wave_speed_m_s = 0;  ///< c = √(E_max/ρ_min)
+  double force_n = 0;         ///< E_max·h²
+  double wave_speed_m_s = 0;  ///< √(E_max/ρ_min)
   double size_m = 0;          ///< L, the lattice's diagonal
 };
 EquilibriumScales equilibrium_scales(const Lattice& lattice, const ElementArrays& elements);
 
-/// Whether check c meets the equilibrium criterion at tolerance tol: the largest residual force
-/// ≤ tol·F_ref and, for the dynamic integrators, the largest speed ≤ tol·c; for relaxation, whose
+/// Whether check c meets the equilibrium criterion at tolerance tol: every free element's residual
+/// force ≤ tol·E·h² and, for the dynamic integrators, its speed ≤ tol·√(E/ρ), E the largest
+/// modulus of the element and its free hyperelastic neighbours (StateCheck's ratios); for relaxation, whose
 /// speeds are fictitious, the distance still to go, max speed / ω_min ≤ tol·L instead (its slowest
 /// mode decays as e^(−ω_min·t); docs/PHYSICS.md, "Fast equilibrium"). Runs, probe presses, force
 /// curves and fit solves stop on it.

@@ -50,6 +50,11 @@ struct RunSummary {
   double steps_per_second = 0;
   bool converged = false;
   std::string stop_reason;          ///< "equilibrium", "max_steps", "max_time"
+  /// Why a run that was to reach equilibrium (stop.equilibrium > 0) has no converged result: it
+  /// stopped at max_steps or time, or met the test only trivially (the load itself below the
+  /// tolerance). Empty when converged, or when the equilibrium test was off (a run of a fixed
+  /// number of steps or time, as asked).
+  std::string unconverged_reason;
   double final_residual = 0;        ///< max residual force / reference force (dimensionless)
   double final_speed_ratio = 0;     ///< max speed / elastic wave speed (dimensionless)
   double max_displacement_m = 0;

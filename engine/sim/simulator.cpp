@@ -119,6 +119,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   biphasic_ = el.biphasic;
   plan_launches(scene, el, cl);
   if (stress_pair_) device_bytes_ += n_ * 4 * 4 * real_size_;  // the predicted stage's Q rows and C
+  device_bytes_ += 2 * n_ * real_size_;  // the check's per-element scales
   require_fits_device(device_bytes_, n_, cells, el.hyperelastic, scene, cl.info);
 
   const PaddedGrid padded = make_padded_grid(lattice);
@@ -311,6 +312,9 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   check_.setArg(kCheckIndenter + kIndenterArgs, partial_);
   check_.setArg(kCheckIndenter + kIndenterArgs + 1, partial_arg_);
   check_.setArg(kCheckIndenter + kIndenterArgs + 2, cl_uint(n_));
+  check_scale_ = cl::Buffer(cl.context, CL_MEM_READ_ONLY, 2 * n_ * real_size_);
+  write_check_scale(el);
+  check_.setArg(kCheckIndenter + kIndenterArgs + 3, check_scale_);
   if (relax_) {
     const int relax_arg = kCheckVolume + (volume_ ? 2 : 0) + (scene.tori.empty() ? 0 : 1);
     check_.setArg(relax_arg, relax_scale_);
@@ -595,6 +599,33 @@ std::vector<unsigned char> Simulator::real_bytes(const std::vector<double>& valu
   return out;
 }
 
+void Simulator::write_check_scale(const ElementArrays& el) {
+  // Each element's residual and speed over its own scales, E·h² and √(E/ρ), E the largest modulus
+  // of the element and its free hyperelastic neighbours: their stress acts on it, so round-off in
+  // a stiff neighbour's stress (float: ~1e-7 of it) must not hold a soft element above the test,
+  // while one element further the soft tissue's own scale applies. A spring neighbour acts through
+  // the connection's series stiffness, at most twice the element's own (docs/PHYSICS.md, section 9).
+  // 1e300 (float: saturated) where E is not positive, so such an element never passes.
+  const auto hyperelastic = [&](std::size_t e) {  // the kernels' law ids 1 and 2
+    const double law = el.material_table.empty() ? 0 : el.material_table[lattice_.tissue_of_element[e]][0];
+    return law == 1 || law == 2;
+  };
+  const double h = lattice_.spacing_m;
+  std::vector<double> scale(2 * n_, 1e300);
+  for (std::size_t e = 0; e < n_; ++e) {
+    double E = el.youngs_modulus_pa[e];
+    for (const std::int32_t j : lattice_.neighbours(e))
+      if (j >= 0 && el.inverse_mass[std::size_t(j)] != 0 && hyperelastic(std::size_t(j)))
+        E = std::max(E, el.youngs_modulus_pa[std::size_t(j)]);
+    const double rho = el.mass_kg[e] / (h * h * h);
+    if (!(E > 0) || !(rho > 0)) continue;
+    scale[2 * e] = std::min(1e300, 1 / (E * h * h));
+    scale[2 * e + 1] = std::min(1e300, std::sqrt(rho / E));
+  }
+  const std::vector<unsigned char> bytes = real_bytes(scale);
+  cl_.queue.enqueueWriteBuffer(check_scale_, CL_TRUE, 0, bytes.size(), bytes.data());
+}
+
 cl::Buffer Simulator::make_real_buffer(const std::vector<double>& values) const {
   std::vector<unsigned char> data = real_bytes(values);
   return cl::Buffer(cl_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, data.size(), data.data());
@@ -777,7 +808,8 @@ StateCheck Simulator::check() {
   c.tori.assign(scene_.tori.size(), TorusContactCheck{});
   for (std::size_t g = 0; g < check_groups_; ++g) {
     const double* q = &p[g * check_slots_];
-    c.max_residual_n = std::max(c.max_residual_n, q[0]);
+    c.residual_ratio = std::max(c.residual_ratio, q[0]);
+    c.speed_ratio = std::max(c.speed_ratio, q[5]);
     if (q[1] > c.max_speed_m_s || c.fastest_element < 0) {
       c.max_speed_m_s = q[1];
       c.fastest_element = arg[g];

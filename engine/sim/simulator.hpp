@@ -51,8 +51,12 @@ struct IndenterMotion {
 
 /// Device-side reductions over the current state (see kernels/checks.cl).
 struct StateCheck {
-  double max_residual_n = 0;      ///< largest net static force on a free element (N)
+  /// largest net static force on a free element over its E·h², E the largest modulus of the
+  /// element and its free hyperelastic neighbours (dimensionless)
+  double residual_ratio = 0;
   double max_speed_m_s = 0;       ///< +inf when some value is not finite
+  /// largest speed of a free element over its wave speed √(E/ρ), E as above (dimensionless)
+  double speed_ratio = 0;
   double kinetic_energy_j = 0;
   double max_displacement_m = 0;
   std::vector<Vec3> indenter_force_n;           ///< per indenter: force the tissue exerts on it (N)
@@ -320,6 +324,8 @@ class Simulator {
   void update_relax_from_rest();
   Vec3 gravity_ = Vec3::Zero();
   cl::Buffer relax_scale_, relax_prev_;
+  cl::Buffer check_scale_;  ///< per element 1/(E·h²), 1/√(E/ρ) (kernels/checks.cl)
+  void write_check_scale(const ElementArrays& el);
   bool rest_offsets_ = false;
   cl::Buffer rest_offset_, rest_frame_;  ///< u0 per element; R₀ rows and J₀ (hyperelastic)
   mutable cl::Kernel check_;

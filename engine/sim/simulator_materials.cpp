@@ -32,6 +32,7 @@ void Simulator::set_materials(const ElementArrays& el) {
     const std::vector<unsigned char> bytes = real_bytes(table);
     cl_.queue.enqueueWriteBuffer(materials_, CL_TRUE, 0, bytes.size(), bytes.data());
   }
+  write_check_scale(el);
   dt_ = dt;
   set_time_step_args();
   steps_ = 0;

@@ -99,5 +99,20 @@ TEST(HyperelasticParameters, ConversionsAndErrors) {
   EXPECT_THROW(ogden({100, 1, 2, 3}, {1, 2, 3, 4}, 1e5), Error);
 }
 
+// Drucker stability over tissue's range (uniaxial λ ∈ [0.5, 2], shear γ ∈ [0, 1]): the laws of the
+// docs and tests are stable; C01 < 0 large against C10, or an Ogden term with μ·α < 0 that wins at
+// large stretch, is not, and the place where the stress first stops rising is named.
+TEST(HyperelasticParameters, StabilityOverTissueRange) {
+  EXPECT_EQ(unstable_range(neo_hookean_from_E_nu(3000, 0.4999)), "");
+  EXPECT_EQ(unstable_range(mooney_rivlin(8000, 2000, 1e6)), "");
+  EXPECT_EQ(unstable_range(mooney_rivlin(1000, -100, 1e6)), "");  // mildly negative C01 holds
+  EXPECT_EQ(unstable_range(ogden({1200, -300}, {4, -2}, 1e6)), "");
+  EXPECT_EQ(unstable_range(mooney_rivlin(1000, -999.999, 1e6)), "in uniaxial stress at stretch 0.500");
+  const std::string ogden_soft = unstable_range(ogden({3000, -500}, {2, 8}, 1e6));
+  EXPECT_NE(ogden_soft.find("in uniaxial stress at stretch"), std::string::npos) << ogden_soft;
+  // A small term of high order that wins only in tension (closed form: the stress peaks near 1.863)
+  EXPECT_EQ(unstable_range(ogden({2000, -2}, {2, 10}, 1e6)), "in uniaxial stress at stretch 1.862");
+}
+
 }  // namespace
 }  // namespace vb
