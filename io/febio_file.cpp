@@ -36,7 +36,8 @@ void add_value(pugi::xml_node parent, const char* name, const std::string& value
 
 FebioMaterial febio_material(const MaterialSpec& m) {
   if (m.rigid)
-    return spring_material(m, "rigid: every node of this tissue is fixed, so its law does not act");
+    return spring_material(m, "rigid: its nodes are fixed; written as isotropic elastic with its E, which acts only "
+                              "in cells shared with free tissue");
   if (m.law == "linear")
     return spring_material(m, "linear springs: the same small-strain response (E, nu = 1/4); FEBio's isotropic "
                               "elastic is St Venant-Kirchhoff at large strain");
