@@ -3,23 +3,17 @@
 #include <pugixml.hpp>
 
 #include <algorithm>
-#include <cstdio>
-#include <map>
 
 #include "engine/error.hpp"
 #include "engine/lattice/dual_hexahedra.hpp"
 #include "engine/material/hyperelastic.hpp"
 #include "io/atomic_file.hpp"
+#include "io/csv_table.hpp"
 
 namespace vb {
 namespace {
 
-/// Shortest text that reads back as the same double.
-std::string number(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", v);
-  return buffer;
-}
+std::string number(double v) { return shortest_number_text(v); }
 
 /// Lattice springs: an isotropic lattice with E and ν = 1/4 at small strain (docs/PHYSICS.md).
 FebioMaterial spring_material(const MaterialSpec& m, std::string note) {

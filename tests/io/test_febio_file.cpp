@@ -30,7 +30,7 @@ Lattice block_lattice(int nx, int ny, int nz, const Eigen::Matrix3d& rotation) {
   v.origin_m = Eigen::Vector3d(0.01, -0.02, 0.005);
   v.rotation = rotation;
   v.tissue_names = {"soft", "stiff"};
-  v.labels.assign(v.voxel_count(), 0);
+  v.labels.assign(std::size_t(nx) * ny * (nz + 1), 0);
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) v.labels[v.linear_index(i, j, k)] = k >= nz - 2 ? 2 : 1;
