@@ -1,8 +1,11 @@
-// voxbreast info — lists OpenCL platforms and devices (memory, fp64) and which one is the default.
+// voxbreast info — lists OpenCL platforms and devices (memory, fp64), which one is the default, and
+// the program cache folder with its size.
 #include <cstdio>
 
 #include "apps/commands.hpp"
+#include "apps/program_cache_folder.hpp"
 #include "engine/sim/opencl_runtime.hpp"
+#include "engine/sim/program_cache.hpp"
 
 namespace vb::app {
 
@@ -19,6 +22,13 @@ Command add_info(CLI::App& app) {
       std::printf("     %s, driver %s\n", d.version.c_str(), d.driver.c_str());
     }
     std::printf("* = default device (choose with --device or VOXBREAST_DEVICE=gpu|cpu|N|name)\n");
+    if (const auto& cache = program_cache_folder(); !cache.empty()) {
+      const ProgramCacheUsage usage = program_cache_usage(cache);
+      std::printf("program cache: %s, %zu programs, %.1f MiB (voxbreast cache --clear empties it)\n",
+                  cache.string().c_str(), usage.entries, double(usage.bytes) / (1 << 20));
+    } else {
+      std::printf("program cache: off\n");
+    }
     return 0;
   }};
 }

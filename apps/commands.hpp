@@ -25,5 +25,7 @@ Command add_haptic(CLI::App& app);
 Command add_fit_curve(CLI::App& app);
 Command add_probe(CLI::App& app);
 Command add_fit(CLI::App& app);
+Command add_cache(CLI::App& app);
+Command add_export(CLI::App& app);
 
 }  // namespace vb::app

@@ -7,6 +7,8 @@
 //   voxbreast bench --quick --out out/bench
 //   voxbreast haptic scene.toml --trajectory press.csv --rate-hz 1000 --out out/haptic
 //   voxbreast probe data-samples/palpation/scene.toml --out out/palpation
+//   voxbreast cache --clear
+//   voxbreast export data-samples/phantom/scene.toml --feb out/phantom.feb
 // Every subcommand has --help. Errors print one line naming the problem and exit non-zero (2 for
 // a misused command line, 4 for a run that went unstable, 1 for everything else; simulate exits 3
 // when its result is not converged).
@@ -14,9 +16,11 @@
 #include <cstdio>
 
 #include "apps/commands.hpp"
+#include "apps/program_cache_folder.hpp"
 #include "engine/error.hpp"
 #include "engine/sim/instability.hpp"
 #include "engine/sim/opencl_runtime.hpp"
+#include "engine/sim/program_cache.hpp"
 #include "voxbreast/config.hpp"
 
 int main(int argc, char** argv) {
@@ -26,7 +30,8 @@ int main(int argc, char** argv) {
   const vb::app::Command commands[] = {vb::app::add_info(app), vb::app::add_simulate(app),
                                        vb::app::add_bench(app), vb::app::add_phantom(app),
                                        vb::app::add_sweep(app), vb::app::add_haptic(app),
-                                       vb::app::add_fit_curve(app), vb::app::add_probe(app), vb::app::add_fit(app)};
+                                       vb::app::add_fit_curve(app), vb::app::add_probe(app), vb::app::add_fit(app),
+                                       vb::app::add_cache(app), vb::app::add_export(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -37,6 +42,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "voxbreast: error: %s (see '%s --help')\n", e.what(), command.c_str());
     return 2;
   }
+  vb::set_program_cache_dir(vb::app::program_cache_folder());
   try {
     for (const auto& command : commands)
       if (command.sub->parsed()) return command.run();

@@ -1,9 +1,7 @@
 #include "io/lattice_vtu.hpp"
 
-#include <Eigen/LU>
-
 #include "engine/error.hpp"
-#include "engine/surface/surface_elements.hpp"
+#include "engine/lattice/dual_hexahedra.hpp"
 #include "io/atomic_file.hpp"
 #include "io/vtk_xml_arrays.hpp"
 
@@ -26,21 +24,10 @@ void write_lattice_vtu(const std::string& path, const Lattice& lattice, std::spa
   }
   for (std::size_t e = 0; e < n; ++e) tissue[e] = lattice.tissue_of_element[e];
 
-  // Each complete cell from its corner with the lowest coordinates. VTK's hexahedron order is
-  // the bottom face counter-clockwise seen from the top, then the top face; in a left-handed
-  // world frame the two faces swap so that the cell keeps a positive volume.
-  const std::vector<std::uint8_t> octants = complete_octants_of_elements(lattice);
-  const bool mirrored = lattice.rotation.determinant() < 0;
-  const std::size_t sx = 1, sy = std::size_t(lattice.dims[0]), sz = sy * std::size_t(lattice.dims[1]);
-  const std::size_t corner_offset[8] = {0, sx, sx + sy, sy, sz, sx + sz, sx + sy + sz, sy + sz};
+  // VTK's hexahedron order is the dual cells' (engine/lattice/dual_hexahedra.hpp)
   std::vector<std::int64_t> connectivity, offsets;
-  for (std::size_t e = 0; e < n; ++e) {
-    if (!(octants[e] >> 7)) continue;
-    const std::size_t v = lattice.voxel_of_element[e];
-    for (int k = 0; k < 8; ++k) {
-      const int corner = mirrored ? (k + 4) % 8 : k;
-      connectivity.push_back(lattice.element_of_voxel[v + corner_offset[corner]]);
-    }
+  for (const auto& hex : dual_hexahedra(lattice)) {
+    connectivity.insert(connectivity.end(), hex.begin(), hex.end());
     offsets.push_back(std::int64_t(connectivity.size()));
   }
   const std::vector<std::uint8_t> types(offsets.size(), 12);  // VTK_HEXAHEDRON

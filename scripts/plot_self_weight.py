@@ -2,8 +2,7 @@
 """Plots the large-deformation self-weight study (a 3 cm neo-Hookean cube hanging from its held top
 face) from the CSV that the long test writes.
 
-    VOXBREAST_LONG_TESTS=1 VOXBREAST_VALIDATION_OUT=/tmp \\
-        build/tests/test_physics --gtest_filter='SelfWeightConvergence.Long*'
+    VOXBREAST_VALIDATION_OUT=/tmp build/tests/test_physics --gtest_filter='SelfWeightConvergenceStudy.*'
     /usr/bin/python3 scripts/plot_self_weight.py /tmp/self_weight_convergence.csv docs/img/self_weight_convergence.png
 
 The docs figure adds the 0.375 mm level (VOXBREAST_SELF_WEIGHT_FINEST=81, run on a GPU; levels

@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev libhdf5-dev hdf5-tools
   libgtest-dev googletest
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
+  libssl-dev libpugixml-dev python3-lxml
   libdcmtk-dev dcmtk libnifti2-dev python3-pydicom python3-nibabel clang libclang-rt-14-dev
   python3 python3-matplotlib python3-numpy python3-h5py python3-vtk9
   libopenmpi-dev openmpi-bin

@@ -7,5 +7,8 @@ bash "$root/scripts/setup.sh"
 bash "$root/scripts/build.sh"
 # Tests run on the CPU OpenCL device unless told otherwise (CI has only PoCL).
 export VOXBREAST_DEVICE=${VOXBREAST_DEVICE:-cpu}
+# Built kernels are kept between test processes (and runs) in the build folder.
+export VOXBREAST_CACHE_DIR=${VOXBREAST_CACHE_DIR:-$build/program-cache}
 cd "$build"
-ctest --output-on-failure --parallel "$(nproc)" --timeout 1200
+# Long validation studies and GPU-only checks are labelled and run apart (README, "Quick start").
+ctest --output-on-failure --parallel "$(nproc)" --timeout 1200 -LE "slow|validation|gpu"

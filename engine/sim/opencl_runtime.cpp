@@ -8,10 +8,12 @@
 #include <functional>
 #include <map>
 #include <mutex>
+#include <optional>
 
 #include <CL/cl_ext.h>
 
 #include "engine/error.hpp"
+#include "engine/sim/program_cache.hpp"
 
 namespace vb::kernels {
 const std::vector<std::pair<const char*, const char*>>& embedded_sources();
@@ -122,6 +124,33 @@ DeviceInfo select_device(const std::string& selector_in) {
   return *pick;
 }
 
+namespace {
+
+/// Everything a built binary depends on: a change to any of it (a new driver, other options, an
+/// edited kernel) names another cache entry.
+std::string program_cache_key(const DeviceInfo& d, const std::string& source, const std::string& build_options) {
+  const std::string platform_version = trim(cl::Platform(d.device.getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_VERSION>());
+  return "platform: " + d.platform + " / " + platform_version + "\ndevice: " + d.name + " / " + d.vendor + " / " +
+         d.version + "\ndriver: " + d.driver + "\noptions: " + build_options + "\nsource:\n" + source;
+}
+
+/// The program rebuilt from a cached binary; none when the entry is missing, damaged, or refused by
+/// the driver (which then builds from source and replaces the entry).
+std::optional<cl::Program> load_cached_program(const ClContext& cl, const std::filesystem::path& dir,
+                                               const std::string& key, const std::string& build_options) {
+  const auto binary = read_program_cache(dir, key);
+  if (!binary) return std::nullopt;
+  try {
+    cl::Program program(cl.context, {cl.info.device}, cl::Program::Binaries{*binary});
+    program.build({cl.info.device}, build_options.c_str());
+    return program;
+  } catch (const cl::Error&) {
+    return std::nullopt;
+  }
+}
+
+}  // namespace
+
 ClContext::ClContext(const DeviceInfo& device, bool profiling)
     : info(device),
       context(device.device),
@@ -157,9 +186,17 @@ cl::Program build_program(const ClContext& cl, const std::vector<std::string>& f
     const std::lock_guard<std::mutex> lock(cache_mutex);
     if (const auto it = cache.find(key); it != cache.end()) return it->second;
   }
-  cl::Program program(cl.context, source);
   std::string build_options = options;
   if (const char* extra = std::getenv("VOXBREAST_CL_OPTIONS")) build_options += std::string(" ") + extra;
+  const std::filesystem::path disk = std::getenv("VOXBREAST_DUMP_KERNELS") ? std::filesystem::path() : program_cache_dir();
+  const bool use_disk = !disk.empty();
+  const std::string disk_key = use_disk ? program_cache_key(cl.info, source, build_options) : std::string();
+  if (use_disk)
+    if (auto cached = load_cached_program(cl, disk, disk_key, build_options)) {
+      const std::lock_guard<std::mutex> lock(cache_mutex);
+      return cache.emplace(key, *cached).first->second;
+    }
+  cl::Program program(cl.context, source);
   try {
     program.build({cl.info.device}, build_options.c_str());
     if (const char* dir = std::getenv("VOXBREAST_DUMP_KERNELS")) {
@@ -182,6 +219,10 @@ cl::Program build_program(const ClContext& cl, const std::vector<std::string>& f
     throw Error("OpenCL kernel build failed (" + cl_status_name(e.err()) + ") with options '" + options +
                     "':\n" + trim(log),
                 cl.info.name, "set VOXBREAST_DUMP_KERNELS=DIR to write the full source");
+  }
+  if (use_disk) {
+    const auto binaries = program.getInfo<CL_PROGRAM_BINARIES>();
+    if (binaries.size() == 1 && !binaries[0].empty()) write_program_cache(disk, disk_key, binaries[0]);
   }
   const std::lock_guard<std::mutex> lock(cache_mutex);
   cache.emplace(key, program);

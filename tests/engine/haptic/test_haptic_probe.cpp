@@ -147,7 +147,6 @@ TEST(HapticProbe, BlowUpIsDetectedAndReported) {
   const HapticLoopResult r = run_haptic_loop(probe, press, loop);
   EXPECT_TRUE(r.blown_up);
   EXPECT_NE(r.message.find("blew up"), std::string::npos) << r.message;
-  EXPECT_LT(r.wall_s, 4.0) << "the loop stops at the blow-up, not at the end of the run";
   EXPECT_FALSE(probe.update()) << "a blown-up probe does not update again";
   for (const HapticSample& sample : r.samples) EXPECT_TRUE(sample.force_n.allFinite());
 }

@@ -176,7 +176,7 @@ TEST(Probing, SmallDragOnTrianglesSticks) {
   EXPECT_NEAR(held.force_x_mid, held.force.x(), 0.02 * std::abs(held.force.x())) << "held, not creeping";
 }
 
-// ---- Why the vertex-mode ratio falls short of μ (VOXBREAST_LONG_TESTS=1; docs/VALIDATION.md) ----
+// ---- Why the vertex-mode ratio falls short of μ (ctest label validation; docs/VALIDATION.md) ----
 // The sliding ball at other steps, speeds and integrators; at the end, per contact element: its
 // normal force f_n (the inward part of its lattice force), |f_t|/(μ·f_n) of the tangential rest
 // (what the check's friction_hold compares), its tangential speed relative to the ball and the
@@ -272,9 +272,8 @@ TEST(Probing, FrictionalPressOnTrianglesRelaxes) {
   EXPECT_LT(std::hypot(a.force_n.x(), a.force_n.y()), 0.02 * a.force_n.z());
 }
 
-TEST(Probing, FrictionShortfallStudy) {
-  const char* env = std::getenv("VOXBREAST_LONG_TESTS");
-  if (!env || std::string(env) != "1") GTEST_SKIP() << "set VOXBREAST_LONG_TESTS=1 (a few minutes)";
+// A few minutes on 2 CPU cores.
+TEST(FrictionShortfallStudy, AtOtherStepsSpeedsAndIntegrators) {
   for (Surface surface : {Surface::Vertices, Surface::Triangles}) {
     friction_study(surface, 0.020, 0.5, Integrator::Heun, true);
     for (double safety : {0.25, 0.125}) friction_study(surface, 0.020, safety, Integrator::Heun, false);

@@ -77,7 +77,7 @@ std::vector<double> run_case(Case c, bool persistent, int split = 0, int group_l
 // everywhere (a missing or leaky grid barrier), a stale cached read of another group's writes, a
 // block of elements skipped or done twice, or a projection applied on the wrong steps would give
 // another trajectory than one launch per pass. The same sums in the same order: equal to rounding.
-TEST(PersistentStep, MatchesOneLaunchPerPass) {
+TEST(PersistentStepGpu, MatchesOneLaunchPerPass) {
   const char* names[] = {"springs + volume", "two-term Ogden + volume every third step", "two-term Ogden + moving plate"};
   int k = 0;
   for (const Case c : {Case::SpringsVolume, Case::OgdenVolumeEveryThird, Case::OgdenPlates}) {
@@ -95,7 +95,7 @@ TEST(PersistentStep, MatchesOneLaunchPerPass) {
 // work-groups in all, so that each walks several blocks of every pass (1,100 elements: 9 to 35
 // blocks, about 9 volume groups): a block skipped or done twice, or a group's local memory reused by its
 // next block before it was read, would give another trajectory.
-TEST(PersistentStep, MatchesWithEveryForceSplitAndFewGroups) {
+TEST(PersistentStepGpu, MatchesWithEveryForceSplitAndFewGroups) {
   for (const int split : {1, 2, 4}) {
     const std::vector<double> one = run_case(Case::OgdenVolumeEveryThird, true, split, 3);
     if (one.empty()) GTEST_SKIP() << "no persistent step on this device (NVIDIA GPUs only)";

@@ -25,8 +25,8 @@
 // along the clamped edges form a boundary layer one spacing thick.
 //
 // The CI tests use two levels (n = 6 and 11; 11 and 21 for the small-strain field comparison) and
-// first-order Richardson extrapolation. The study on four or five levels runs only with
-// VOXBREAST_LONG_TESTS=1 and writes a CSV for scripts/plot_self_weight.py.
+// first-order Richardson extrapolation. The study on four or five levels (ctest labels validation
+// and slow) writes a CSV for scripts/plot_self_weight.py.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -267,12 +267,7 @@ TEST(SelfWeightConvergence, SmallStrainNeoHookeanMatchesLinearSprings) {
   EXPECT_LT(std::abs(q_limit), 0.015);
 }
 
-// ---- the study on four or five levels (VOXBREAST_LONG_TESTS=1) ------------------------------
-
-bool long_tests() {
-  const char* v = std::getenv("VOXBREAST_LONG_TESTS");
-  return v && std::string(v) == "1";
-}
+// ---- the study on four or five levels (ctest label validation) ------------------------------
 
 // Levels n = 6, 11, 21, 41 (h = 6, 3, 1.5, 0.75 mm; VOXBREAST_SELF_WEIGHT_FINEST=81 adds
 // 0.375 mm). Cases: neo-Hookean ν 0.45 (the model) and with voxel masses at the full and the small
@@ -280,8 +275,8 @@ bool long_tests() {
 // as a function of strain). Writes self_weight_convergence.csv to VOXBREAST_VALIDATION_OUT (or
 // the build folder). Asserts the observed order of the voxel-mass model on the three finest
 // levels, that both mass models extrapolate to one answer, and the linear departures.
-TEST(SelfWeightConvergence, LongStudyObservedOrderAndLinearDepartures) {
-  if (!long_tests()) GTEST_SKIP() << "set VOXBREAST_LONG_TESTS=1 (about 1 h on 2 CPU cores; 25 s on an H200, 2.5 min with level 81)";
+// About 1 h on 2 CPU cores; 25 s on an H200, 2.5 min with level 81.
+TEST(SelfWeightConvergenceStudy, ObservedOrderAndLinearDepartures) {
   std::vector<int> levels{6, 11, 21, 41};
   if (const char* f = std::getenv("VOXBREAST_SELF_WEIGHT_FINEST"); f && std::atoi(f) == 81) levels.push_back(81);
   std::vector<Case> cases{kNeoHookean, kNeoHookeanVoxelMass, {"neo-hookean", 0.45, kSmallLoad, false},
