@@ -5,7 +5,7 @@
 #   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
 #   device: bash scripts/gpu_haptic.sh          (run tool, carry [".device-pkgs"]; writes $OUT/haptic)
 #   here:   tar -xzf FETCHED/haptic.tar.gz && python3 scripts/haptic_table.py haptic/bench.json   # rows for BENCHMARKS.md
-#           /usr/bin/python3 scripts/plot_force_feedback.py haptic haptic/sample/haptic.csv docs/img/haptic_press_h100.png
+#           /usr/bin/python3 scripts/plot_force_feedback.py haptic haptic/sample/haptic.csv docs/img/haptic_press_h100_DATE_COMMIT.png
 # Extra bench options go in $HAPTIC_ARGS, e.g. HAPTIC_ARGS="--haptic-seconds 10".
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
