@@ -363,10 +363,10 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                           {"force_split", sim.force_split()}, {"persistent_step", sim.persistent_step()},
                           {"stress_pair", sim.stress_pair()}, {"stress_pass_elements", sim.stress_pass_elements()},
                           {"lanes_kernels", sim.lanes()},
-                          // elements on the short connection loop (PERF_NOTES.md change 22)
+                          // elements on the short connection loop (docs/PERFORMANCE.md)
                           {"uniform_loop_elements", sim.uniform_elements()},
                           {"step_list", sim.step_list()},
-                          // Heun's predicted stage packed (PERF_NOTES.md change 27)
+                          // Heun's predicted stage packed (docs/PERFORMANCE.md)
                           {"pred_packed", sim.pred_packed()},
                           // Heun's corrector over the blocks last to first (change 29)
                           {"correct_reverse", sim.correct_reverse()},

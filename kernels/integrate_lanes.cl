@@ -1,5 +1,5 @@
 // Heun, symplectic Euler and dynamic relaxation (kernels/relax.cl) steps of spring models on CPUs
-// (VB_LANES, docs/PERF_NOTES.md changes 14 and 31): the same arithmetic as heun_predict,
+// (VB_LANES, docs/PERFORMANCE.md, "CPU lanes kernels as float8"): the same arithmetic as heun_predict,
 // heun_correct, euler_step and relax_step on linear springs with gravity, global damping and
 // dashpots, each work-item stepping VB_LANE_WIDTH free elements at once in float8 vectors.
 // Why a second form: PoCL runs a work-group as a loop over its work-items, and the real4 kernels
