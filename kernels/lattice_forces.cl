@@ -72,7 +72,7 @@ VB_INLINE void stage_store(global real4* u, global real4* v, uint e, int packed,
 // lattice_force_pending's, (k(|r| − L) + c·Δv·r̂)·r̂, written as s·r with
 // s = k − k·L/|r| + c·(Δv·r)/|r|²: no unit vector, the mask on s alone, h·d's zero components
 // never added: 11% fewer instructions per stage and 7% more steps/s on the H200's 1.5M cube
-// (change 30; the same form lost 1% as attempt 26, before changes 27-29 made the reads cheaper).
+// (docs/PERFORMANCE.md, "Uniform-neighbourhood short loop").
 // A coincident neighbour (|r| = 0) has r = 0, so s·r = 0 as in the general loop.
 // VB_UNIFORM_PATH (host: GPUs, linear springs, no rest offsets, not in the one-launch step).
 #if VB_UNIFORM_PATH

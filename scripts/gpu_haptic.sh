@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Haptic rate on a GPU (issue 9, docs/BENCHMARKS.md "Haptic rate"), in one device call (~2 min):
+# Haptic rate on a GPU (docs/BENCHMARKS.md "Haptic rate"), in one device call (~2 min):
 # the bench's probe-pressing blocks (10k, 40k, 160k elements; force output at 1 kHz) and the
 # voxbreast haptic sample with its force log.
 #   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare

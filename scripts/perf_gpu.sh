@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 7 step-time measurements on a GPU in one device call (~4 min on an H200): the volume,
+# Step-time measurements on a GPU in one device call (~4 min on an H200): the volume,
 # kernel and hyperelastic tests on the GPU first (volume_project and volume_pending rely on a
 # last-work-group count across the device; the GPU runs the split force passes), then per-kernel
 # profiles of the rows docs/PERFORMANCE.md reads: 36k linear, two-term Ogden with and without the
@@ -10,8 +10,8 @@
 # Switches the A/B rows also try (docs/PERFORMANCE.md, "Tools"):
 #   VOXBREAST_FORCE_SPLIT=1|2|4      work-items per element in Heun's force passes (GPU default 2
 #                                    for hyperelastic models up to 98,304 elements)
-#   --volume-predictor projection    the volume rows with Heun's predicted stage projected (change 15)
-#   VOXBREAST_STRESS_PAIR=0          both element stresses of a Heun step in two launches (change 16)
+#   --volume-predictor projection    the volume rows with Heun's predicted stage projected
+#   VOXBREAST_STRESS_PAIR=0          both element stresses of a Heun step in two launches
 #   VOXBREAST_PERSISTENT=0|1         Heun's step as one launch with grid barriers (NVIDIA default
 #                                    for spring models up to 45,056 elements; the 36k rows run
 #                                    the default and =0)

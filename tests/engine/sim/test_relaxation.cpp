@@ -1,5 +1,5 @@
 // Dynamic relaxation (solver.integrator = "relaxation"): it must land on the same equilibrium as
-// plain damped dynamics, in far fewer steps (docs/PHYSICS.md, "Fast equilibrium"; issue 7).
+// plain damped dynamics, in far fewer steps (docs/PHYSICS.md, "Fast equilibrium").
 #include <gtest/gtest.h>
 
 #include <algorithm>
