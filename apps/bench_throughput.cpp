@@ -30,7 +30,7 @@ struct BenchCase {
 };
 
 /// The bundled phantom's spacing for a ~36k-element breast (34,961 elements at 3.2 mm; 18,413 at
-/// its own 4 mm): the size of the main paper's hyperelastic breast model and of issue 7's target.
+/// its own 4 mm): the size of the main paper's hyperelastic breast model and of the 36k target (docs/BENCHMARKS.md).
 constexpr double kBreastSpacing = 0.0032;
 
 /// A cube of `edge`³ adipose elements, base held, under gravity: the standard linear block, its
@@ -363,14 +363,14 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
                           {"force_split", sim.force_split()}, {"persistent_step", sim.persistent_step()},
                           {"stress_pair", sim.stress_pair()}, {"stress_pass_elements", sim.stress_pass_elements()},
                           {"lanes_kernels", sim.lanes()},
-                          // elements on the short connection loop (PERF_NOTES.md change 22)
+                          // elements on the short connection loop (docs/PERFORMANCE.md)
                           {"uniform_loop_elements", sim.uniform_elements()},
                           {"step_list", sim.step_list()},
-                          // Heun's predicted stage packed (PERF_NOTES.md change 27)
+                          // Heun's predicted stage packed (docs/PERFORMANCE.md)
                           {"pred_packed", sim.pred_packed()},
-                          // Heun's corrector over the blocks last to first (change 29)
+                          // Heun's corrector over the blocks last to first (docs/PERFORMANCE.md)
                           {"correct_reverse", sim.correct_reverse()},
-                          // the stepping kernels' work-group size, 0: the device's choice (change 28)
+                          // the stepping kernels' work-group size, 0: the device's choice (docs/PERFORMANCE.md)
                           {"step_work_group", sim.step_work_group()},
                           {"dashpot_ratio", scene.solver.dashpot_ratio},
                           // the same kernels without their arithmetic (engine/bench/gather_floor.hpp)

@@ -24,7 +24,7 @@ struct ThroughputOptions {
   bool breast_large = false;  ///< also time it at ~1.5M elements (model "breast_large"), linear springs
   /// also time it resampled to about each of these element counts (model "breast_resampled"),
   /// each law and integrator: the phantom's rate against size (where the step list and the
-  /// one-launch step pay, docs/PERF_NOTES.md changes 23 and 24)
+  /// one-launch step pay, docs/PERFORMANCE.md, "Launches per step")
   std::vector<long> breast_elements;
   std::vector<std::string> breast_integrators{"heun"};  ///< those models' integrators (bench knob names)
 };

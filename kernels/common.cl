@@ -32,7 +32,7 @@ typedef float2 real2;
 typedef float4 real4;
 #endif
 
-// The stepping path's functions are always inlined (docs/PERF_NOTES.md, change 13): PoCL's inliner
+// The stepping path's functions are always inlined (docs/PERFORMANCE.md, "CPU lanes kernels"): PoCL's inliner
 // left the unrolled force loop and its callers as calls, made for every work-item with ~25
 // arguments on the stack; inlined, the same scalar code runs 1.4x faster. GPU compilers inline
 // them anyway.
@@ -173,7 +173,7 @@ inline void pending_v(real4* vj, real4 wg, VB_PENDING_PARAMS) {
 // The kernels a step launches (the stepping kernels, element_stress, volume_partials,
 // volume_apply) take it as their last argument and each of those arrays as its offset (units of
 // VB_ARENA_UNIT bytes) where a buffer argument would be: one buffer argument instead of up to
-// six per launch (docs/PERF_NOTES.md, change 19). Other kernels take the arrays as buffers (the
+// six per launch (docs/PERFORMANCE.md, "State layout and the arena"). Other kernels take the arrays as buffers (the
 // host's sub-buffers); no kernel takes both the arena and a sub-buffer of it (OpenCL leaves
 // concurrent use of a buffer and its sub-buffers undefined).
 #define VB_STATE_PARAM , global uchar *state_arena

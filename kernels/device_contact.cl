@@ -68,7 +68,7 @@ VB_INLINE real4 friction_hold(real4* f, real4 n, real fn, real mu) {
 // to it above `slip`, m/s) carries the kinetic friction μ·fn along its slip: what the steps'
 // grip applies to it, whatever its own tangential force is at this instant (a sliding element's
 // spring force swings about μ·fn as it slides; capping it at μ·fn, as for one at rest, reads the
-// swings short: docs/VALIDATION.md, issue 9 "Friction"). One at rest on the surface (the grip
+// swings short: docs/VALIDATION.md, "Contact with devices", friction). One at rest on the surface (the grip
 // stopped it) carries its tangential force up to μ·fn (friction_hold).
 VB_INLINE real4 friction_carried(real4* f, real4 n, real fn, real mu, real4 v_rel, real slip) {
   const real4 vt = xyz0(v_rel) - dot3(v_rel, n) * n;

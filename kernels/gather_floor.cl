@@ -7,7 +7,7 @@
 // a neighbour), so that the compiler keeps every load. The results are meaningless as physics;
 // the stage is written into the floor's own buffers. Built with -DVB_DOUBLE=0 (float words) and
 // -DVB_FLOOR_DASHPOT=0|1 as the step's VB_DASHPOT: only the connection dashpots read the
-// neighbours' velocities. docs/PERF_NOTES.md, session 31.
+// neighbours' velocities. docs/PERFORMANCE.md, "What bounds the step: the gather floor".
 #ifndef VB_FLOOR_DASHPOT
 #define VB_FLOOR_DASHPOT 1
 #endif

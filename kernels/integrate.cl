@@ -222,7 +222,7 @@ VB_INLINE void predict_element(uint e, global const real4* u, global const real4
 // Heun's corrector for element e (u', v' into u, v; the same calling rule as predict_element):
 // `pending` of the state (u, v) for the element's own u, v, and pred_* of the predicted stage.
 // The element's own u, v are read after the force loop, so they are not live across it (fewer
-// registers: PERF_NOTES.md change 20); the held test reads ũ.w, which the predictor copies from u
+// registers); the held test reads ũ.w, which the predictor copies from u
 // (packed, VB_PRED_PACKED: u.w itself).
 VB_INLINE void correct_element(uint e, global real4* u, global real4* v, global const real4* u_pred,
                                global const real4* v_pred, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS, real dt, uint n,
@@ -279,7 +279,7 @@ kernel VB_STEP_ATTR void heun_predict(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PA
 // still holds one block of marks) from the last to the first, each block in order. It then starts
 // on the lines heun_predict wrote last, still in L2, and ends on the elements the next
 // heun_predict starts with (H200, linear cubes of 1.0M-1.5M elements: 4-5% more steps/s, both
-// stages reading 17-45% less from DRAM; docs/PERF_NOTES.md change 29 and session 27). Each
+// stages reading 17-45% less from DRAM; docs/PERFORMANCE.md, "Work-group sizes"). Each
 // element's arithmetic is its own, so the order changes no result.
 #ifndef VB_CORRECT_REVERSE
 #define VB_CORRECT_REVERSE 0

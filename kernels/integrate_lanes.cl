@@ -1,10 +1,10 @@
 // Heun, symplectic Euler and dynamic relaxation (kernels/relax.cl) steps of spring models on CPUs
-// (VB_LANES, docs/PERF_NOTES.md changes 14 and 31): the same arithmetic as heun_predict,
+// (VB_LANES, docs/PERFORMANCE.md, "CPU lanes kernels as float8"): the same arithmetic as heun_predict,
 // heun_correct, euler_step and relax_step on linear springs with gravity, global damping and
 // dashpots, each work-item stepping VB_LANE_WIDTH free elements at once in float8 vectors.
 // Why a second form: PoCL runs a work-group as a loop over its work-items, and the real4 kernels
-// step one element per iteration on scalar SSE instructions. Change 14 wrote them on scalar
-// components and left the widening across work-items to LLVM's loop vectoriser; its cost model
+// step one element per iteration on scalar SSE instructions. A form on scalar components
+// that left the widening across work-items to LLVM's loop vectoriser; its cost model
 // accepted the neighbours' gathers on AVX-512 CPUs only, so on AVX2 CPUs (AMD EPYC Zen 3, PoCL's
 // "haswell") the loop ran scalar again, with no sign but the speed. Here the vectors are written
 // out: every CPU with 256-bit vectors runs 8 elements per instruction, whatever a cost model says.

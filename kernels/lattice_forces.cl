@@ -29,7 +29,7 @@ inline real spring_end(int law, global const real* mat, real k, real len, real r
 // (ũx, ũy, ũz, ṽx) and its v array's first half (ṽy, ṽz) as real2, so a warp's read of a
 // neighbour's state touches 4 + 2 cache lines instead of 4 + 4: the reads cost by the lines they
 // touch (H200: heun_correct 10% shorter, the 1.5M cube's step 3-5%, 512k's 7%; docs/
-// PERF_NOTES.md change 27). The inverse mass is not in it: it stays in the state's u.w (w_of),
+// PERFORMANCE.md, "Packed predicted stage"). The inverse mass is not in it: it stays in the state's u.w (w_of),
 // which no stage changes (heun_correct writes each u[e] back with the same w, so a neighbour reads
 // the same inverse mass before or after). `packed` is a constant at every call (0: the stage as
 // two real4 arrays). Only the host's plain case uses it: one work-item per element, no step list,
@@ -68,11 +68,11 @@ VB_INLINE void stage_store(global real4* u, global real4* v, uint e, int packed,
 // have its E and inverse mass w, which the host marks with a negative E (engine/sim/
 // uniform_neighbourhood.hpp). Then E_ij = E, k = κ_d·h·E and the dashpot's 2ζ·√(k/(2w)) =
 // 2ζ·√(h·E/(2w))·√κ_d, one square root per element: no neighbour modulus to load and no
-// reciprocal or square root per connection (docs/PERF_NOTES.md change 22). The same force as
+// reciprocal or square root per connection (docs/PERFORMANCE.md, "Uniform-neighbourhood short loop"). The same force as
 // lattice_force_pending's, (k(|r| − L) + c·Δv·r̂)·r̂, written as s·r with
 // s = k − k·L/|r| + c·(Δv·r)/|r|²: no unit vector, the mask on s alone, h·d's zero components
 // never added: 11% fewer instructions per stage and 7% more steps/s on the H200's 1.5M cube
-// (change 30; the same form lost 1% as attempt 26, before changes 27-29 made the reads cheaper).
+// (docs/PERFORMANCE.md, "Uniform-neighbourhood short loop").
 // A coincident neighbour (|r| = 0) has r = 0, so s·r = 0 as in the general loop.
 // VB_UNIFORM_PATH (host: GPUs, linear springs, no rest offsets, not in the one-launch step).
 #if VB_UNIFORM_PATH

@@ -1,5 +1,5 @@
-// Heun's whole step in one launch (-DVB_PERSISTENT=1; NVIDIA GPUs, small models; docs/PERF_NOTES.md
-// change 12). A step is up to 8 dependent passes, and NVIDIA's OpenCL spends ~5 µs of host time
+// Heun's whole step in one launch (-DVB_PERSISTENT=1; NVIDIA GPUs, small models; docs/PERFORMANCE.md,
+// "One-launch persistent step"). A step is up to 8 dependent passes, and NVIDIA's OpenCL spends ~5 µs of host time
 // per launch, more than the passes themselves take at 36k elements. Here one launch of
 // co-resident work-groups runs the passes in turn, each over the whole model (a group takes
 // blocks of elements, strided by the number of groups), with a grid-wide barrier between them:
@@ -39,7 +39,7 @@ inline void trace_stamp(volatile global uint* sync, uint k) {
 // the comparison survives the count's wrap-around). In each group item 0 fences, between
 // work-group barriers: its device fence (membar.gl) publishes the group's writes before it counts
 // and, after the wait, makes the SM's loads miss lines other groups have since written (with
-// OpenCL's mem_fence instead, a test kernel read stale L1 lines: docs/PERF_NOTES.md change 12).
+// OpenCL's mem_fence instead, a test kernel read stale L1 lines: docs/PERFORMANCE.md).
 inline void grid_barrier(volatile global uint* sync, uint target, uint* stamps) {
   barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
   if (get_local_id(0) == 0) {

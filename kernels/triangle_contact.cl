@@ -17,7 +17,7 @@ inline int uses_triangles(global const real* ind) { return ind[18] != 0; }
 
 // The penalty's gap r − |p − c| comes from absolute positions (tens of mm): in float their
 // rounding (~4e-9 m) times k_p is a force noise of ~2e-5·E·h² per element, which stalled float
-// relaxations there (docs/VALIDATION.md, issue 9). On an fp64 device the geometry is computed in
+// relaxations there (docs/VALIDATION.md, "Probing: palpation and indenters"). On an fp64 device the geometry is computed in
 // double (the state stays float), which removes that noise; the pass is per surface triangle, cheap.
 #if VB_TRI_FP64
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable

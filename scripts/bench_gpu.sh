@@ -3,7 +3,8 @@
 # H200; results are rewritten after every run, so a call cut short keeps what it did).
 #   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
 #   device: bash scripts/bench_gpu.sh            (run tool, carry [".device-pkgs"]; writes $OUT/bench)
-#   here:   bash scripts/bench_gpu.sh plot FETCHED/bench h200   # docs/results/ and docs/img/ files
+#   here:   bash scripts/bench_gpu.sh plot FETCHED/bench h200_DATE_COMMIT   # docs/results/, docs/img/ files
+#           (named by device, date and commit, as bench.json's `device`, `date`, `commit` say)
 # $BENCH_TIMEOUT (s) stops the study early but still packs what it wrote.
 # Extra bench options go in $BENCH_ARGS, e.g. BENCH_ARGS="--scenes phantom_large --laws neo-hookean".
 set -euo pipefail
@@ -12,13 +13,13 @@ cd "$root"
 
 if [[ "${1:-}" == "plot" ]]; then
   dir=${2:?folder with bench.csv}
-  name=${3:-h200}
+  name=${3:?name: device_date_commit, e.g. h200_2026-12-02_a7560de}
   /usr/bin/python3 tests/apps/check_bench.py "$dir" || echo "check_bench found problems (see above)"
   cp "$dir/bench.csv" "docs/results/bench_study_$name.csv"
   cp "$dir/bench.json" "docs/results/bench_study_$name.json"
-  [[ -f "$dir/throughput.csv" ]] && cp "$dir/throughput.csv" "docs/results/bench_$name.csv"
+  [[ -f "$dir/throughput.csv" ]] && cp "$dir/throughput.csv" "docs/results/bench_throughput_$name.csv"
   /usr/bin/python3 scripts/plot_bench_study.py "$dir" "docs/img/bench_study_$name" "$name"
-  [[ -f "$dir/throughput.csv" ]] && /usr/bin/python3 scripts/plot_bench.py "$dir/throughput.csv" "docs/img/bench_scaling_$name.png" "$name"
+  [[ -f "$dir/throughput.csv" ]] && /usr/bin/python3 scripts/plot_bench.py "$dir/throughput.csv" "docs/img/bench_throughput_$name.png" "$name"
   exit 0
 fi
 
@@ -26,7 +27,7 @@ out=${OUT:?run on the device machine, where \$OUT is the folder that comes back}
 mkdir -p "$out"
 bash scripts/gpu_run.sh run voxbreast info >"$out/device.txt" 2>&1 || true
 # SM clock and power every 250 ms: long float runs reach the card's power cap and clock down
-# (docs/PERF_NOTES.md, session 18), which the timed rates then include.
+# (docs/PERFORMANCE.md, "Denormals and the power cap"), which the timed rates then include.
 smi=""
 if command -v nvidia-smi >/dev/null; then
   nvidia-smi --query-gpu=timestamp,clocks.sm,power.draw,clocks_throttle_reasons.active --format=csv -lms 250 \

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8: is "tumour modulus within 10% with 0.5 mm noise" a data limit? (docs/VALIDATION.md,
+# Is "tumour modulus within 10% with 0.5 mm noise" a data limit? (docs/VALIDATION.md,
 # "Noise and the Cramér–Rao bound"). The noisy variant of scripts/validate_fit.sh (same phantoms,
 # seed, initial guess, σ = 0.5 mm) per case; each fit's summary.json carries the Cramér–Rao
 # standard error of every region's ln E from its last Jacobian (modulus_pa.*.relative_standard_error),

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8's timing: one inverse fit of a ~36k-element phantom with 8 regions on the GPU (goal ≤ 60 s),
+# Fit timing: one inverse fit of a ~36k-element phantom with 8 regions on the GPU (goal ≤ 60 s),
 # with the Jacobian's perturbed solves one at a time (fit.batch = 1) and batched on the device
 # (fit.batch = 9, BATCH=N to change: all 9 perturbed copies in one simulator; "auto" now solves one
 # at a time, docs/FIT.md "Batched solves"). Both summaries' jacobian_timing (setup, uploads,

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# Haptic rate on a GPU (issue 9, docs/BENCHMARKS.md "Haptic rate"), in one device call (~2 min):
+# Haptic rate on a GPU (docs/BENCHMARKS.md "Haptic rate"), in one device call (~2 min):
 # the bench's probe-pressing blocks (10k, 40k, 160k elements; force output at 1 kHz) and the
 # voxbreast haptic sample with its force log.
 #   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
 #   device: bash scripts/gpu_haptic.sh          (run tool, carry [".device-pkgs"]; writes $OUT/haptic)
 #   here:   tar -xzf FETCHED/haptic.tar.gz && python3 scripts/haptic_table.py haptic/bench.json   # rows for BENCHMARKS.md
-#           /usr/bin/python3 scripts/plot_force_feedback.py haptic haptic/sample/haptic.csv docs/img/haptic_press_h100.png
+#           /usr/bin/python3 scripts/plot_force_feedback.py haptic haptic/sample/haptic.csv docs/img/haptic_press_h100_DATE_COMMIT.png
 # Extra bench options go in $HAPTIC_ARGS, e.g. HAPTIC_ARGS="--haptic-seconds 10".
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Probing on a GPU (issue 9), in one device call (a few minutes): the palpation sample (timing) and
+# Probing on a GPU, in one device call (a few minutes): the palpation sample (timing) and
 # the palpation truth-cube sweep at 2 mm spacing (64,000 elements, presses every 4 mm).
 #   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
 #   device: bash scripts/gpu_probe.sh            (carry [".device-pkgs"]; writes $OUT/probe)

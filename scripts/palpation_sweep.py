@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The palpation paper's truth-cube study (000_cec263896ad2aa44.txt; docs/VALIDATION.md,
-"Issue 9 — probing"): an 8 cm cube of adipose (500 Pa) with a spherical tumour (10 kPa), a line
+"Probing: palpation and indenters"): an 8 cm cube of adipose (500 Pa) with a spherical tumour (10 kPa), a line
 of presses across the top (every 8 mm). Sweeps the tumour diameter (1–4 cm, centre 2.6 cm deep) and depth
 (1.8–3.8 cm, diameter 2 cm), each against the tumour-free cube; reports the force-profile excess,
 its FWHM, and the press depth at given forces with and without the tumour.

@@ -1,17 +1,17 @@
 #!/usr/bin/env bash
-# Issue 7 step-time measurements on a GPU in one device call (~4 min on an H200): the volume,
+# Step-time measurements on a GPU in one device call (~4 min on an H200): the volume,
 # kernel and hyperelastic tests on the GPU first (volume_project and volume_pending rely on a
 # last-work-group count across the device; the GPU runs the split force passes), then per-kernel
-# profiles of the rows docs/PERF_NOTES.md reads: 36k linear, two-term Ogden with and without the
+# profiles of the rows docs/PERFORMANCE.md reads: 36k linear, two-term Ogden with and without the
 # volume constraint (the 20k target row), and 1.5M two-term Ogden, Heun, float.
 # With a reference build (.device-pkgs/ref.tar.xz holding bin/voxbreast of another commit, made by
 # `bash scripts/perf_gpu.sh ref BUILD_DIR` here) the same rows run with it too, interleaved with
 # this build's, so that one call gives an A/B on one device.
-# Switches the A/B rows also try (docs/PERF_NOTES.md, changes 7–9):
+# Switches the A/B rows also try (docs/PERFORMANCE.md, "Tools"):
 #   VOXBREAST_FORCE_SPLIT=1|2|4      work-items per element in Heun's force passes (GPU default 2
 #                                    for hyperelastic models up to 98,304 elements)
-#   --volume-predictor projection    the volume rows with Heun's predicted stage projected (change 15)
-#   VOXBREAST_STRESS_PAIR=0          both element stresses of a Heun step in two launches (change 16)
+#   --volume-predictor projection    the volume rows with Heun's predicted stage projected
+#   VOXBREAST_STRESS_PAIR=0          both element stresses of a Heun step in two launches
 #   VOXBREAST_PERSISTENT=0|1         Heun's step as one launch with grid barriers (NVIDIA default
 #                                    for spring models up to 45,056 elements; the 36k rows run
 #                                    the default and =0)
@@ -70,13 +70,13 @@ for round in 1 2; do
   row "36k_r$round" voxbreast --sizes 33 --laws linear ogden --volume
   # one launch per pass instead of the persistent step (kernels/persistent.cl)
   VOXBREAST_PERSISTENT=0 row "36k_launches_r$round" voxbreast --sizes 33 --laws linear ogden --volume
-  # Heun's predicted stage projected instead of under the lagged pressure (PERF_NOTES.md change 15)
+  # Heun's predicted stage projected instead of under the lagged pressure (docs/PERFORMANCE.md, "Volume projection forms")
   row "36k_projection_r$round" voxbreast --sizes 33 --laws ogden --volume --volume-predictor projection
   [[ -n "$ref" ]] && row "36k_ref_r$round" "$ref" --sizes 33 --laws linear ogden --volume
 done
 # the breast phantom at 3.2 mm (34,961 elements, a third of them moving) next to the cube
 row 36k_breast voxbreast --breast --sizes 33 --laws linear neo-hookean ogden --volume
-# both of Heun's element stresses in two launches instead of one (PERF_NOTES.md change 16)
+# both of Heun's element stresses in two launches instead of one (docs/PERFORMANCE.md, "Volume projection forms")
 VOXBREAST_STRESS_PAIR=0 row 36k_breast_nopair voxbreast --breast --sizes 33 --laws ogden --volume
 VOXBREAST_FORCE_SPLIT=1 row 36k_split1 voxbreast --sizes 33 --laws ogden --volume
 VOXBREAST_FORCE_SPLIT=4 row 36k_split4 voxbreast --sizes 33 --laws ogden --volume

@@ -2,7 +2,7 @@
 """Plots a `voxbreast bench` study: error against wall time to equilibrium with the Pareto front
 (one panel per scene), and steps/s against element count.
 
-    /usr/bin/python3 scripts/plot_bench_study.py out/bench docs/img/bench_pocl "PoCL, 2 cores"
+    /usr/bin/python3 scripts/plot_bench_study.py out/bench docs/img/bench_study_pocl-2cores_DATE_COMMIT "PoCL, 2 cores"
 
 Reads OUT/bench.csv (and OUT/throughput.csv when present); writes PREFIX_pareto.png and
 PREFIX_scaling.png.

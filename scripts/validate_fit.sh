@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8 validation (docs/VALIDATION.md, "Issue 8 — inverse fitting"), the source paper's protocol:
+# Fit validation (docs/VALIDATION.md, "Fitting: inverse fitting of moduli"), the source paper's protocol:
 # a phantom with one spherical tumour of literature stiffness per case (DCIS, invasive ductal
 # carcinoma, fibroadenoma; two sizes, different positions), its supine → prone displacement
 # simulated with the true moduli (adipose 3.25 kPa, fibroglandular 6 kPa, the tumour's literature

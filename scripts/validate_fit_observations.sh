@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Issue 8 validation of the two observation/forward-model options of docs/FIT.md
-# (docs/VALIDATION.md, "Issue 8 — label-map observations and the unloaded reference state"):
+# Validation of the two observation/forward-model options of docs/FIT.md
+# (docs/VALIDATION.md, "Label-map observations and the unloaded reference state"):
 #   labels     — the observation is the phantom's label map after the supine → prone change
 #                (simulated with the true moduli, voxelised at 1 mm), matched by surface distances
 #                of the body outline and the tumour (labels_body: the body outline only);

@@ -11,7 +11,7 @@ namespace vb::bench {
 /// two chunks back, so that the queue never holds more than three chunks. A run issues at most
 /// check_every steps before it reads back; thousands of steps at once fill NVIDIA's queue, and the
 /// host blocked inside the driver then leaves gaps between launches (~20 µs per step at 1.5M
-/// elements: docs/PERF_NOTES.md, session 17) that no run has.
+/// elements) that no run has.
 void advance_paced(const cl::CommandQueue& queue, const std::function<void(std::int64_t)>& advance, std::int64_t steps);
 
 /// Steps per second of `advance`, timed over enough steps to last about `target_s` (batches

@@ -76,7 +76,7 @@ std::size_t ForwardModel::batch_size() const {
   // auto: one at a time on every device. Measured (docs/FIT.md, "Batched solves"): a batch runs
   // every copy for as many steps as its slowest (K·max instead of Σ steps: 23% more element-steps
   // on the 38.7k-element phantom); it was slower per Jacobian on PoCL (+12%) and on an H200 (0.17–
-  // 0.21 against 0.150–0.156 s in session 38: the GPU relaxes the batch 2.6× faster, but the nine
+  // 0.21 against 0.150–0.156 s one at a time, 2026-12-03: the GPU relaxes the batch 2.6× faster, but the nine
   // copies' new moduli cost as much host time as nine solves' and the batch's relaxation saves less;
   // docs/FIT.md). Batches stay available as fit.batch = N.
   return 1;

@@ -21,7 +21,7 @@ constexpr double kContactTol = 1e-3;  // of a spacing, as REAL_CONTACT_TOL (kern
 // as the haptic loop does (0.25 h per 20 steps). Placed a whole increment deep at once, it pushes
 // the surface elements with k_p·increment; their fast contact mode is barely damped (relaxation
 // damps the slowest mode), so they overshoot by about the increment, and 1 mm increments at
-// h = 2 mm folded the layer below and lost the contact (docs/VALIDATION.md, issue 9).
+// h = 2 mm folded the layer below and lost the contact (docs/VALIDATION.md, "Probing: palpation and indenters").
 constexpr double kPenaltyRampPerStep = 0.0125;
 
 struct Relaxed {

@@ -3,9 +3,9 @@
 /// (VB_CORRECT_REVERSE, kernels/integrate.cl): on GPUs from 1,000,000 elements, without the volume
 /// constraint. The predictor walks the elements first to last, so the corrector then starts on the
 /// predicted stage's most recently written lines and ends on the elements the next predictor reads
-/// first. Measured on the H200 (docs/PERF_NOTES.md change 29), linear cubes: +4–5% at 1.0M and
+/// first. Measured on the H200 (docs/PERFORMANCE.md, "Work-group sizes"), linear cubes: +4–5% at 1.0M and
 /// 1.5M, +2.5% at 4.1M, level at 512k (its DRAM reads fall by ~45%, but DRAM does not bound that
-/// step: Nsight Compute, PERF_NOTES.md session 27) and 3% slower at 262k (not known why);
+/// step: Nsight Compute) and 3% slower at 262k (not known why);
 /// two-term Ogden +0.5%, and with the volume constraint level.
 #include <cstddef>
 

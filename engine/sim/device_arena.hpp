@@ -2,7 +2,7 @@
 /// Several device arrays in one OpenCL buffer, each at an offset aligned for sub-buffers.
 ///
 /// Why: NVIDIA's OpenCL spends about 0.4 µs of host time per buffer argument of every launch
-/// (2 buffers: ~5 µs per launch; 28: ~14 µs; measured on an H200, docs/PERF_NOTES.md change 11).
+/// (2 buffers: ~5 µs per launch; 28: ~14 µs; measured on an H200, docs/PERFORMANCE.md, "State layout and the arena").
 /// A 36k-element step's kernels take less than that, so the host's launches set the pace. Kernels
 /// take the one buffer and the arrays' offsets (`uint8`/`uint4` arguments, in units of kUnit
 /// bytes, -DVB_ARENA_UNIT); the host keeps a sub-buffer per array for its own reads and writes.

@@ -11,12 +11,12 @@ inline constexpr int kCheckWorkGroup = 128;
 inline constexpr std::size_t kVolumeGpuWorkGroup = 512;
 // VB_SPLIT (kernels/integrate.cl): work-group size of the split Heun kernels, and the model size
 // up to which GPUs split: Ogden on the H200 gained 3–9% at 36k and 76k, lost 4.5% at 125k (cube)
-// and 13.5% at 262k (cube), 6–23% at 147k–246k (phantom; docs/PERF_NOTES.md change 24)
+// and 13.5% at 262k (cube), 6–23% at 147k–246k (phantom; docs/PERFORMANCE.md, "Launches per step")
 inline constexpr std::size_t kSplitWorkGroup = 128, kSplitMaxElements = 98304;
 // Spring models up to this size take Heun's one-launch step on NVIDIA (kernels/persistent.cl):
 // up to 43k cubes it held ~70k steps/s in every round while the launched step, host-bound there,
 // ranged 60–78k (level in the mean); at 47k the launched step won by 3%, at 64k–216k by 26–53%
-// (H200; docs/PERF_NOTES.md changes 24 and 25).
+// (H200; docs/PERFORMANCE.md, "Launches per step").
 inline constexpr std::size_t kPersistentMaxElements = 45056;
 // VB_LANE_WIDTH (kernels/integrate_lanes.cl): free elements per work-item of the CPU lanes kernels
 inline constexpr std::size_t kLaneWidth = 8;

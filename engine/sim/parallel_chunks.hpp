@@ -14,7 +14,7 @@ namespace vb {
 
 /// How many chunks [0, n) is split into: one per core, each at least min_per_chunk long (a
 /// thread's start, tens of µs, is then under a tenth of its share of the walk; 16,384 left the
-/// 38.7k phantom's walk on 2 of the H200 host's 16 cores: docs/PERF_NOTES.md, "Session 38").
+/// 38.7k phantom's walk on 2 of the H200 host's 16 cores: docs/PERFORMANCE.md, "Relaxation: mass scaling and host walks").
 inline std::size_t chunk_count(std::size_t n, std::size_t min_per_chunk = 4096) {
   const std::size_t cores = std::max(1u, std::thread::hardware_concurrency());
   return std::max<std::size_t>(1, std::min(cores, n / std::max<std::size_t>(1, min_per_chunk)));

@@ -28,7 +28,7 @@ struct PersistentPlan {
 
 /// Heun scenes without triangle contact or folded volume projections, on an NVIDIA GPU: by default
 /// spring models up to `max_elements` (VOXBREAST_PERSISTENT=0 turns it off, =1 on for any size and
-/// for hyperelastic models, where it measured slower: docs/PERF_NOTES.md change 12). Groups per
+/// for hyperelastic models, where it measured slower: docs/PERFORMANCE.md, "One-launch persistent step"). Groups per
 /// compute unit: enough for one block of elements per group in the widest pass (force_split
 /// work-items per element), 2 to 6; the register cap 65,536 / (128 · groups per unit), in
 /// multiples of 8, is what NVIDIA's register file then lets reside if the compiler keeps to it

@@ -189,12 +189,12 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   // rcp and sqrt then skip their denormal fix-up: the 1.5M linear Heun float step 3-4.5% shorter
   // on the H200 (device time).
   // Not for the one-launch step, which it made 4% slower (36k linear), nor on CPUs, whose tests'
-  // references keep IEEE denormals (docs/PERF_NOTES.md, change 21).
+  // references keep IEEE denormals (docs/PERFORMANCE.md, "Denormals and the power cap").
   if (cl.info.is_gpu && !persistent_.on) options += " -cl-denorms-are-zero";
   // Torus contact settles only with correctly rounded float division and square root: with
   // NVIDIA's default ones (about 2 ulp) a dome squeezed by an inflating torus kept a residual of
   // 6.6e-4 for 60,000 steps, against 1,600 steps to 6e-7 with this option, as on PoCL
-  // (tests/engine/device/test_torus_contact.cpp; docs/PERF_NOTES.md, "A GPU-only test failure").
+  // (tests/engine/device/test_torus_contact.cpp; docs/PERFORMANCE.md, "GPU-only guards").
   const auto fp32 = cl.info.device.getInfo<CL_DEVICE_SINGLE_FP_CONFIG>();
   if (!scene.tori.empty() && (fp32 & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT))
     options += " -cl-fp32-correctly-rounded-divide-sqrt";
@@ -349,7 +349,7 @@ void Simulator::set_time_step_args() {
 // Heun's predicted stage packed (kernels/lattice_forces.cl, stage_load): ũ with ṽx in one real4,
 // ṽy, ṽz in a real2, so a warp's read of a neighbour's stage touches 6 cache lines instead of 8
 // (H200, linear cubes: heun_correct 10% shorter, the step 3-5% at 1.5M, 7% at 512k; docs/
-// PERF_NOTES.md change 27). Where the short loop takes at least half the free elements: the general
+// PERFORMANCE.md, "Packed predicted stage"). Where the short loop takes at least half the free elements: the general
 // loop reads each neighbour's inverse mass from the state, a third line (the phantom at 50k-60k,
 // none on the short loop: 0 to 5% slower). Only where heun_correct alone reads the stage: no volume
 // constraint, indenters, tori or triangle contact, one work-item per element and no list (whose
@@ -368,7 +368,7 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
   if (volume_) {
     // A projection is two launches on GPUs (volume_partials, volume_apply) and one elsewhere
     // (volume_project). On an H200 the one-launch form's last work-group, applying the projection
-    // alone, took 21.8 µs against 7.9 + 10.8 µs for the two launches (docs/PERF_NOTES.md); on PoCL
+    // alone, took 21.8 µs against 7.9 + 10.8 µs for the two launches (docs/PERFORMANCE.md); on PoCL
     // the two cost the same. VOXBREAST_VOLUME_LAUNCHES=1|2 overrides, to compare them on a device.
     // 0 (Heun only): no apply launch at all, the kernels that read the state next apply the
     // pending projection (volume_pending; kernels/common.cl, VB_PENDING_PARAMS).
@@ -418,7 +418,7 @@ void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const
   correct_reverse_ = reverse_allowed && default_correct_reverse(cl.info.is_gpu, n_, volume_);
   if (const char* env = std::getenv("VOXBREAST_CORRECT_REVERSE")) correct_reverse_ = reverse_allowed && std::atoi(env) != 0;
   // Linear springs on GPUs: elements whose neighbours share their E and mass take a short
-  // connection loop (kernels/lattice_forces.cl, lattice_force_uniform; PERF_NOTES.md change 22),
+  // connection loop (kernels/lattice_forces.cl, lattice_force_uniform; docs/PERFORMANCE.md),
   // marked by a negative E in whole warps (uniform_neighbourhood.hpp). Not in the one-launch step,
   // whose register cap the second loop overflows (36k cube 72.9k → 47.9k steps/s on the H200), nor
   // with the lanes kernels (skipping the neighbour's E saves little on a CPU). Off

@@ -25,7 +25,7 @@ constexpr int sync_arg(bool volume) { return volume ? kProject + 1 : kMesh; }
 void Simulator::make_persistent_kernel() {
   cl::Kernel& k = persistent_kernel_ = cl::Kernel(program_, "heun_step_persistent");
   // Every group must be resident at once: the build log says how many registers the kernel
-  // really uses (docs/PERF_NOTES.md, "A GPU-only failure of the one-launch step in double").
+  // really uses (docs/PERFORMANCE.md, "GPU-only guards").
   persistent_.fit_registers(
       registers_in_build_log(program_.getBuildInfo<CL_PROGRAM_BUILD_LOG>(cl_.info.device), "heun_step_persistent"),
       cl_.info.compute_units);

@@ -1,7 +1,7 @@
 #pragma once
 /// When GPUs step over a list of the free elements (VB_STEP_LIST, kernels/common.cl) by default:
 /// models above a size, of which at least a quarter are held. Measured on the H200 with the
-/// phantom (docs/PERF_NOTES.md changes 23, 24, 25 and 26): from 56k up the list paid for every
+/// phantom (docs/PERFORMANCE.md, "Step list"): from 56k up the list paid for every
 /// law and integrator but hyperelastic relaxation, which lost 4–8% at 56k–64k and 1–2% at 76k and
 /// gained 1–6% from 90k, so it takes the list from a larger size. Below ~50k the list lost for
 /// every law and integrator (up to 32%): each pass there is bound by its chain of dependent loads,

@@ -2,14 +2,14 @@
 /// Work-items per group of the stepping kernels on GPUs where each work-item steps one element or
 /// one listed element (kernels/integrate.cl, relax.cl; not the split force pass, the one-launch step
 /// or the CPU lanes kernels, which have their own): 256 from 131,072 elements, 128 below. Measured
-/// on the H200 (docs/PERF_NOTES.md change 28): groups of 256 took 10–12% off the Heun step of the
+/// on the H200 (docs/PERFORMANCE.md, "Work-group sizes"): groups of 256 took 10–12% off the Heun step of the
 /// 1.5M and 4.1M linear cubes, 4–5% off 512k and 2–4% off 262k (springs, neo-Hookean and Ogden,
 /// with and without the volume constraint), 8% off the 1.5M phantom (step list) and 3–5% off the
 /// 500k phantom (Heun, symplectic Euler, relaxation); below, level within the noise (the 64k cube
 /// +1%, the 120k phantom −2% to +1%). 512 lost at 512k and 1,024 everywhere. Why: the neighbour
 /// rows a group's warps share in their SM's L1. Nsight Compute on the prototype's step at 1.5M
-/// (PERF_NOTES.md, session 27) measured the L1 hit rate at 76% in groups of 256 against 66% in
-/// groups of 128, and 12% less L2 traffic. (Groups shaped as tiles, attempt 33, shrank the
+/// measured the L1 hit rate at 76% in groups of 256 against 66% in
+/// groups of 128, and 12% less L2 traffic. (Groups shaped as tiles shrank the
 /// footprint further but gained at most 2.6%: the cube's partial tiles idle lanes.)
 #include <cstddef>
 

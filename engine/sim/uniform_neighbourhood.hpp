@@ -14,8 +14,8 @@ namespace vb {
 /// free elements of a block or none (held ones never: they skip the force loop). A GPU steps
 /// consecutive elements in groups of work-items that execute together (the device's simd_width),
 /// and a group that holds both kinds runs both loops: on the 1.5M phantom, where tissue
-/// interfaces are everywhere, marking element by element made the step 31% slower (PERF_NOTES.md
-/// change 23).
+/// interfaces are everywhere, marking element by element made the step 31% slower (docs/PERFORMANCE.md,
+/// "Uniform-neighbourhood short loop").
 std::vector<double> mark_uniform_neighbourhoods(const Lattice& lattice, const std::vector<double>& E,
                                                 const std::vector<double>& inverse_mass, std::size_t lockstep = 1);
 

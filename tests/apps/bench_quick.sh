@@ -41,7 +41,7 @@ print("breast throughput rows:", {m: round(float(r["steps_per_s"]), 1) for m, r 
 PY
 # On PoCL every row here (float, linear springs, no contact) steps with the CPUs' float8 kernels
 # (kernels/integrate_lanes.cl): a scene feature that silently sent them back to the real4 kernels
-# would cost ~3x (PERF_NOTES.md change 31).
+# would cost ~3x (docs/PERFORMANCE.md, "CPU lanes kernels as float8").
 /usr/bin/python3 - "$work/throughput/bench.json" <<'PY'
 import json, sys
 bench = json.load(open(sys.argv[1]))

@@ -1,7 +1,7 @@
 // voxbreast fit-curve's engine (engine/curve_fit): the force-feedback paper's test model, a 6 cm
 // cube of nonlinear (biphasic) springs held on every face but the top and pressed at the middle
 // of the top face. A curve simulated with known parameters, fitted from a perturbed start, must
-// give the parameters back with a small fit error (docs/VALIDATION.md, "Issue 9 — fit-curve").
+// give the parameters back with a small fit error (docs/VALIDATION.md, "Probing: fitting force curves").
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,5 +1,5 @@
 // Indentation of a thick block by a rigid sphere and by a flat cylindrical punch, against the
-// closed forms of contact mechanics (docs/VALIDATION.md, "Issue 9 — probing"). The linear lattice
+// closed forms of contact mechanics (docs/VALIDATION.md, "Probing: palpation and indenters"). The linear lattice
 // has ν = 1/4 (docs/PHYSICS.md, section 2), so E* = E/(1 − ν²) = 16E/15.
 //   Hertz (sphere of radius R, depth δ):  F = (4/3)·E*·√R·δ^{3/2}
 //   Sneddon (flat punch of radius a):     F = 2·a·E*·δ

@@ -3,7 +3,7 @@
 // The force profile's excess over the tumour-free cube is a bump above the tumour whose width
 // (FWHM) must grow with the tumour's diameter; the displacement at a given force is smaller above
 // the tumour. A coarse (4 mm) lattice keeps this at CI size; scripts/palpation_sweep.py runs the
-// paper's ranges at 2 mm (docs/VALIDATION.md, "Issue 9 — probing").
+// paper's ranges at 2 mm (docs/VALIDATION.md, "Probing: palpation and indenters").
 #include <gtest/gtest.h>
 
 #include "engine/probe/force_profile.hpp"

@@ -177,7 +177,7 @@ TEST(TriangleContact, PointProbeBetweenVerticesFeelsTheSurface) {
 // dip into a sphere through them by up to the sagitta s = h²/(4R) (0.056 mm here), so triangle
 // contact, which keeps the faces out of the ball, presses the vertices deeper than vertex contact:
 // with a rigid penalty it is vertex contact of a ball of radius R + s at the same centre. The
-// penalty's own compliance keeps it below that (docs/VALIDATION.md, issue 9).
+// penalty's own compliance keeps it below that (docs/VALIDATION.md, "Probing: palpation and indenters").
 struct HertzPress {
   std::vector<double> depth_m, force_n;
   Vec3 last_force_n = Vec3::Zero();

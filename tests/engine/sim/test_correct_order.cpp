@@ -68,7 +68,7 @@ TEST(CorrectOrder, OnlyHeunsCorrectorInElementOrder) {
 }
 
 // On GPUs from 1,000,000 elements without the volume constraint (H200: linear cubes +4-5% at 1.0M
-// and 1.5M, level at 512k, 3% slower at 262k; level with the constraint; PERF_NOTES.md change 29).
+// and 1.5M, level at 512k, 3% slower at 262k; level with the constraint; docs/PERFORMANCE.md).
 TEST(CorrectOrder, DefaultRule) {
   EXPECT_FALSE(default_correct_reverse(true, 512000, false));
   EXPECT_FALSE(default_correct_reverse(true, 999999, false));

@@ -1,4 +1,4 @@
-// Stability at the extremes (issue 4), hyperelastic tissue: a stiff inclusion 1 to 1000 times
+// Stability at the extremes (docs/VALIDATION.md), hyperelastic tissue: a stiff inclusion 1 to 1000 times
 // stiffer than its surroundings, ν = 0.499, 60% compression between plates, an inverted element,
 // runs forced above the stable step, and the automatic step of a mixed model against
 // docs/PHYSICS.md ("Time step"). Small blocks (6³–8³) in float; most runs use symplectic Euler,

@@ -73,7 +73,7 @@ std::vector<double> run(const Scene& s, bool lanes) {
 // held element that moved, a free element left out, or a held element's stale entry in the
 // scratch state (the lanes kernels step the free elements only) would give another trajectory.
 // The forms differ only where the compiler may fuse a·b + c differently (-cl-mad-enable) in
-// float8 and float4 code; on PoCL (AMD EPYC Zen 3, AVX2; the scalar form of change 14 on Zen 4,
+// float8 and float4 code; on PoCL (AMD EPYC Zen 3, AVX2; an earlier scalar form on Zen 4,
 // AVX-512) they agreed exactly; the bound leaves room for other fusing.
 TEST(LanesStep, MatchesReal4Kernels) {
   const std::map<Integrator, std::string> names = {

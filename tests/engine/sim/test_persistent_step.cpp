@@ -105,7 +105,7 @@ TEST(PersistentStepGpu, MatchesWithEveryForceSplitAndFewGroups) {
 
 // The one-launch step's kernel runs on NVIDIA GPUs only, so a change to a helper it shares with the
 // separate kernels (a parameter added to predict_element) could leave it unbuildable without any
-// CPU test noticing: it did once (session 14's lagged pressure), and every spring model stepping
+// CPU test noticing: it did once (the lagged pressure's new parameter), and every spring model stepping
 // with Heun on a GPU failed to build. Here each case's program is built again as the GPU would
 // build it, with the one-launch step compiled in (not launched: PoCL's groups are not co-resident),
 // with one and two work-items per element. Runs everywhere.

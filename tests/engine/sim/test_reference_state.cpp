@@ -1,4 +1,4 @@
-// The unloaded reference state (docs/PHYSICS.md §13; issue 6): rest offsets must be what the
+// The unloaded reference state (docs/PHYSICS.md §13): rest offsets must be what the
 // kernels treat as rest, and the estimate must find rest offsets from which the CT's gravity
 // lands the model on the CT.
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // Dynamic relaxation (solver.integrator = "relaxation"): it must land on the same equilibrium as
-// plain damped dynamics, in far fewer steps (docs/PHYSICS.md, "Fast equilibrium"; issue 7).
+// plain damped dynamics, in far fewer steps (docs/PHYSICS.md, "Fast equilibrium").
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -77,7 +77,7 @@ TEST_P(RelaxationColumn, ReachesTheDampedEquilibriumInFewerSteps) {
             << " steps; max displacement " << damped.max_displacement_m * 1e3 << " mm, difference "
             << difference * 1e3 << " mm\n";
   EXPECT_GT(damped.max_displacement_m, 1e-4);  // the load does something
-  // Both stop at a residual of 1e-6·E·h²: they agree to a hundredth of a millimetre (the issue's
+  // Both stop at a residual of 1e-6·E·h²: they agree to a hundredth of a millimetre (the target's
   // bar for the phantom is 0.1 mm), under 0.2% of the largest displacement.
   EXPECT_LT(difference, 1e-5);
   EXPECT_LT(difference, 2e-3 * damped.max_displacement_m);

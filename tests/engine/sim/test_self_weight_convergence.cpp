@@ -1,4 +1,4 @@
-// Large-deformation self-weight (issue 4): a soft neo-Hookean cube (E = 1 kPa, ν = 0.45,
+// Large-deformation self-weight (docs/VALIDATION.md, "Self-weight and finite-element cross-check"): a soft neo-Hookean cube (E = 1 kPa, ν = 0.45,
 // ρ = 1000 kg/m³) hangs from its held top face under gravity, and the vertical displacement of the
 // centre of its free (bottom) face is followed as the spacing is refined; then the same cube with
 // linear lattice springs, at small loads (0.07% and 0.7% strain) and at the full load (≈ 27%

@@ -49,7 +49,7 @@ TEST(StepWorkGroup, GroupSizeChangesNoBitHyperelastic) {
   EXPECT_EQ(test::differing_values(run(s, "32", false), run(s, "256", false)), 0u);
 }
 
-// 256 from 131,072 elements (H200: 2–12% from 262k up, level below; PERF_NOTES.md change 28).
+// 256 from 131,072 elements (H200: 2–12% from 262k up, level below; docs/PERFORMANCE.md).
 TEST(StepWorkGroup, DefaultRuleTakesLargerGroupsForLargeModels) {
   EXPECT_EQ(default_step_work_group(36000), 128u);
   EXPECT_EQ(default_step_work_group(131071), 128u);
