@@ -8,12 +8,13 @@
 //   voxbreast haptic scene.toml --trajectory press.csv --rate-hz 1000 --out out/haptic
 //   voxbreast probe data-samples/palpation/scene.toml --out out/palpation
 // Every subcommand has --help. Errors print one line naming the problem and exit non-zero (2 for
-// a misused command line, 1 for everything else).
+// a misused command line, 4 for contact a run cannot keep, 1 for everything else).
 #include <CL/opencl.hpp>
 #include <cstdio>
 
 #include "apps/commands.hpp"
 #include "engine/error.hpp"
+#include "engine/sim/contact_checks.hpp"
 #include "engine/sim/opencl_runtime.hpp"
 #include "voxbreast/config.hpp"
 
@@ -38,6 +39,9 @@ int main(int argc, char** argv) {
   try {
     for (const auto& command : commands)
       if (command.sub->parsed()) return command.run();
+  } catch (const vb::ContactError& e) {
+    std::fprintf(stderr, "voxbreast: error: %s\n", e.what());
+    return 4;
   } catch (const vb::Error& e) {
     std::fprintf(stderr, "voxbreast: error: %s\n", e.what());
     return 1;
