@@ -4,6 +4,8 @@
 // reports success or blames the time step.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "engine/error.hpp"
 #include "engine/sim/contact_checks.hpp"
 #include "engine/sim/run.hpp"
@@ -44,6 +46,7 @@ TEST_P(HeldTension, TheManualsTensionTestHoldsTheTopLayer) {
   s.stop.max_steps = 200000;
   const test::Model m = test::make_model(s);
   Simulator sim(s, m.lattice, m.elements, test::cl_context());
+  std::printf("dt %.3g s: the plate moves %.3g·h per step\n", sim.dt_s(), speed * sim.dt_s() / kH);
   ASSERT_GT(speed * sim.dt_s(), 2e-3 * kH) << "the plate must move beyond the contact band per step";
   const RunOutput out = run_simulation(s, m.lattice, m.elements, sim);
   ASSERT_TRUE(out.summary.converged) << out.summary.stop_reason;
