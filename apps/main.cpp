@@ -10,7 +10,8 @@
 //   voxbreast cache --clear
 //   voxbreast export data-samples/phantom/scene.toml --feb out/phantom.feb
 // Every subcommand has --help. Errors print one line naming the problem and exit non-zero (2 for
-// a misused command line, 4 for a run that went unstable, 1 for everything else; simulate exits 3
+// a misused command line, 4 for a run that went unstable or
+// cannot keep its contact, 1 for everything else; simulate exits 3
 // when its result is not converged).
 #include <CL/opencl.hpp>
 #include <cstdio>
@@ -19,6 +20,7 @@
 #include "apps/program_cache_folder.hpp"
 #include "engine/error.hpp"
 #include "engine/sim/instability.hpp"
+#include "engine/sim/contact_checks.hpp"
 #include "engine/sim/opencl_runtime.hpp"
 #include "engine/sim/program_cache.hpp"
 #include "voxbreast/config.hpp"
@@ -47,6 +49,9 @@ int main(int argc, char** argv) {
     for (const auto& command : commands)
       if (command.sub->parsed()) return command.run();
   } catch (const vb::InstabilityError& e) {
+    std::fprintf(stderr, "voxbreast: error: %s\n", e.what());
+    return vb::app::kExitUnstable;
+  } catch (const vb::ContactError& e) {
     std::fprintf(stderr, "voxbreast: error: %s\n", e.what());
     return vb::app::kExitUnstable;
   } catch (const vb::Error& e) {

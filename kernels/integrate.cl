@@ -57,13 +57,14 @@ VB_INLINE real4 acceleration_from(real4 f, uint e, real4 ui, real4 vi, VB_LATTIC
 
 // Ends a stage: moves an element that ended inside an indenter or a torus tube back onto its
 // surface (indenters first; the obstacle table holds both).
-VB_INLINE void finish_stage(uint e, real4* un, real4* vn, global const uint* cell_of, int sy, int sz,
-                            real4 origin, real h, global const real* indenters, real t) {
+// u_start is the element's displacement where the stage began, at t_start (held contacts).
+VB_INLINE void finish_stage(uint e, real4* un, real4* vn, real4 u_start, global const uint* cell_of, int sy, int sz,
+                            real4 origin, real h, global const real* indenters, real t_start, real t) {
 #if VB_INDENTERS || VB_TORI
   const real4 X = rest_position(cell_of[e], sy, sz, origin, h);
 #endif
 #if VB_INDENTERS
-  contact_project_all(un, vn, X, indenters, t, h);
+  contact_project_all(un, vn, X, X + xyz0(u_start), indenters, t_start, t, h);
 #endif
 #if VB_TORI
   torus_project_all(un, vn, X, indenters, t, h);
@@ -74,6 +75,7 @@ VB_INLINE void finish_stage(uint e, real4* un, real4* vn, global const uint* cel
 VB_INLINE void explicit_update(uint e, real4* ui, real4* vi, real4 f, VB_LATTICE_PARAMS, VB_INDENTER_PARAMS,
                                real dt, int symplectic VB_TRI_PARAMS) {
   torus_grip grip = {0};  // friction of the indenters and tori (no-op without VB_FRICTION)
+  const real4 u_start = *ui;
   // the stage ends at u + dt·v + dt²·a (symplectic) or, through ṽ, at Heun's u' = u + dt·v + dt²/2·a
   const real gain = (symplectic ? (real)1 : (real)0.5) * dt * dt;
   real4 a = acceleration_from(f, e, *ui, *vi, VB_LATTICE_ARGS, indenters, t_force, dt, gain, &grip VB_TRI_ARGS);
@@ -86,7 +88,7 @@ VB_INLINE void explicit_update(uint e, real4* ui, real4* vi, real4 f, VB_LATTICE
   *ui += dt * xyz0(*vi);
   if (!symplectic) *vi += dt * a;
   if (!symplectic) torus_apply_grip(vi, grip, dt);
-  finish_stage(e, ui, vi, cell_of, sy, sz, origin, h, indenters, t_project);
+  finish_stage(e, ui, vi, u_start, cell_of, sy, sz, origin, h, indenters, t_force, t_project);
 }
 
 // The corrector's end for free element e once the lattice force f at (ũ, ṽ) is known: returns v',
@@ -103,7 +105,7 @@ VB_INLINE real4 correct_update(uint e, real4* ui, real4 vi, real4 up, real4 vp, 
   real4 vn = xyz0((vi + vp) * (real)0.5 + (real)0.5 * dt * a);
   torus_apply_grip(&vn, grip, (real)0.5 * dt);  // the predictor's half reaches vn through ṽ
   *ui += (real)0.5 * dt * xyz0(vi + vp);
-  finish_stage(e, ui, &vn, cell_of, sy, sz, origin, h, indenters, t_project);
+  finish_stage(e, ui, &vn, up, cell_of, sy, sz, origin, h, indenters, t_force, t_project);
   return vn;
 }
 

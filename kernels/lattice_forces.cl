@@ -356,9 +356,13 @@ inline void contact_constrain_all(real4* f, real4 x, real4 v, real lead, real re
 
 // Moves an element that ended inside an indenter (deeper than contact_resolution) back onto its
 // surface; its normal velocity becomes at least the indenter's (push). A held element (slide,
-// stick: within the contact tolerance) is put back on the surface and takes the indenter's normal
-// velocity (slide) or its whole velocity (stick).
-inline void contact_project_all(real4* ui, real4* vi, real4 X, global const real* indenters, real t, real h) {
+// stick) is put back on the surface and takes the indenter's normal velocity (slide) or its whole
+// velocity (stick). Held means: within the contact tolerance of the surface where the stage began
+// (x_start at t_start, the element whose force contact_constrain carried), or inside or within the
+// tolerance where it ends (newly reached). The stage's start decides, not its end, so an indenter
+// that moves further than the tolerance in one stage keeps the elements it holds.
+inline void contact_project_all(real4* ui, real4* vi, real4 X, real4 x_start, global const real* indenters,
+                                real t_start, real t, real h) {
   for (int i = 0; i < VB_INDENTERS; ++i) {
     global const real* ind = indenters + VB_IND_STRIDE * i;
     const int mode = (int)ind[13];
@@ -368,7 +372,11 @@ inline void contact_project_all(real4* ui, real4* vi, real4 X, global const real
     real4 n;
     const real4 x = X + xyz0(*ui);
     const real dist = indenter_distance(x, ind, t, &n);
-    if (mode == 0 ? dist >= -contact_resolution(x) : fabs(dist) > REAL_CONTACT_TOL * h) continue;
+    if (mode == 0 && dist >= -contact_resolution(x)) continue;
+    if (mode != 0 && dist > REAL_CONTACT_TOL * h) {
+      real4 n_start;
+      if (fabs(indenter_distance(x_start, ind, t_start, &n_start)) > REAL_CONTACT_TOL * h) continue;
+    }
     *ui -= dist * n;
     const real4 w = indenter_velocity(ind, t);
     const real vn = dot3(*vi, n), wn = dot3(w, n);

@@ -21,6 +21,7 @@ kernel void relax_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENT
   const uint e = VB_STEP_INDEX(get_global_id(0));
   if (e >= VB_STEP_N) return;
   real4 ui = u[e], vi = v[e];
+  const real4 u_start = ui;
   if (ui.w != 0) {
     // acceleration() is f/m with the indenters' constraint (no global damping is compiled in);
     // m/m̃ turns it into f/m̃, then the fictitious damping.
@@ -38,7 +39,7 @@ kernel void relax_step(VB_STEP_STATE_PARAMS, VB_LATTICE_KERNEL_PARAMS, VB_INDENT
     vi = xyz0(vi + dt * a);
     torus_apply_grip(&vi, grip, dt);
     ui += dt * vi;
-    finish_stage(e, &ui, &vi, cell_of, sy, sz, origin, h, indenters, t_project);
+    finish_stage(e, &ui, &vi, u_start, cell_of, sy, sz, origin, h, indenters, t_force, t_project);
   }
   u_out[e] = ui;
   v_out[e] = vi;

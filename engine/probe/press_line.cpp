@@ -17,12 +17,16 @@ namespace vb {
 namespace {
 
 constexpr double kContactTol = 1e-3;  // of a spacing, as REAL_CONTACT_TOL (kernels/common.cl)
-// A triangle-contact (penalty) probe moves to each increment at most this many spacings per step,
-// as the haptic loop does (0.25 h per 20 steps). Placed a whole increment deep at once, it pushes
-// the surface elements with k_p·increment; their fast contact mode is barely damped (relaxation
-// damps the slowest mode), so they overshoot by about the increment, and 1 mm increments at
-// h = 2 mm folded the layer below and lost the contact (docs/VALIDATION.md, "Probing: palpation and indenters").
-constexpr double kPenaltyRampPerStep = 0.0125;
+// The probe moves to each increment at most this many spacings per step, as the haptic loop does
+// (0.25 h per 20 steps), so the increments do not change the answer (docs/PROBING.md, "Increments").
+// Placed a whole increment deep at once, a triangle-contact (penalty) probe pushes the surface
+// elements with k_p·increment; their fast contact mode is barely damped (relaxation damps the
+// slowest mode), so they overshoot by about the increment, and 1 mm increments at h = 2 mm folded
+// the layer below and lost the contact (docs/VALIDATION.md, "Probing: palpation and indenters"). A vertex-contact probe
+// placed an increment deep projects the elements it lands on back onto its nearest surface: a
+// punch throws those near its rim onto its side wall, where they no longer bear on its face, and
+// an increment of a spacing lets the punch pass through the surface layer.
+constexpr double kRampPerStep = 0.0125;
 
 struct Relaxed {
   StateCheck check;
@@ -152,9 +156,9 @@ ProbeResult run_press_line(const Scene& scene, const Lattice& lattice, const Ele
       sample.depth_m = p.depth_m * j / p.steps;
       const Vec3 target = start + sample.depth_m * dir;
       std::int64_t ramp_steps = 0;
-      if (triangles && j > 0) {
+      if (j > 0) {
         const Vec3 from = start + (p.depth_m * (j - 1) / p.steps) * dir;
-        ramp_steps = std::int64_t(std::ceil((target - from).norm() / (kPenaltyRampPerStep * h)));
+        ramp_steps = std::int64_t(std::ceil((target - from).norm() / (kRampPerStep * h)));
         const double t0 = sim.time_s();
         sim.set_indenter_motion(p.indenter, IndenterMotion::straight(from, target, t0, t0 + ramp_steps * sim.dt_s()));
       } else {

@@ -1,5 +1,7 @@
 #include "engine/sim/instability.hpp"
 
+#include "engine/sim/contact_checks.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -98,6 +100,7 @@ void require_anchored(const Scene& scene, const Lattice& lattice, const ElementA
 
 void report_instability(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const Simulator& sim,
                         const StateCheck& c, const std::string& what, const std::string& element_role) {
+  refuse_indenter_in_held_tissue(scene, lattice, el, sim);  // the cause, when it is one
   std::ostringstream msg;
   msg << "simulation went unstable at step " << sim.steps() << " (t = " << sim.time_s() << " s): " << what;
   if (c.fastest_element >= 0) msg << element_role << element_name(lattice, std::size_t(c.fastest_element));

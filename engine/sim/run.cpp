@@ -11,6 +11,7 @@
 #include "engine/sim/instability.hpp"
 #include "engine/results/element_measures.hpp"
 #include "engine/sim/element_mass.hpp"
+#include "engine/sim/contact_checks.hpp"
 #include "engine/surface/enclosed_volume.hpp"
 
 namespace vb {
@@ -170,6 +171,7 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
     if (!ind.path.empty()) travel_end = std::max(travel_end, ind.path.back().time_s);
   }
   for (const TorusSpec& t : scene.tori) travel_end = std::max(travel_end, torus_inflation_end_s(t));
+  check_contact_before_run(scene, lattice, el, sim);
   const std::int64_t check_every = std::max(1, scene.solver.check_every);
   const std::int64_t frames_every = scene.output.frames_every;
   std::int64_t max_steps = scene.stop.max_steps;
@@ -250,6 +252,8 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
   const SurfaceMesh& surface = sim.surface_mesh() ? *sim.surface_mesh() : built;
   const double rest_volume = enclosed_volume_m3(surface, element_positions_m(lattice));
   if (rest_volume != 0) s.surface_volume_change = enclosed_volume_m3(surface, st.position_m) / rest_volume - 1;
+  if (std::any_of(st.volumetric_strain.begin(), st.volumetric_strain.end(), [](double j) { return j <= -1; }))
+    refuse_indenter_in_held_tissue(scene, lattice, el, sim);  // crushed elements: the cause, when it is one
   require_no_inverted_element(lattice, el, st);
 
   s.elements = n;
