@@ -132,11 +132,17 @@ TEST(Extremes, StiffInclusionFromRatio1To1000) {
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const double r = ratios[i];
     EXPECT_TRUE(runs[i].converged) << "ratio " << r << " after " << runs[i].steps << " steps";
-    // The tumour's interior sets the bound from ratio 1 up: ω_max ∝ √ratio exactly, and dt ∝ 1/√ratio
-    // up to the global damping γ, which matters only next to ω_max at ratio 1 (a few %).
-    EXPECT_NEAR(runs[i].omega_max / runs[0].omega_max, std::sqrt(r), 1e-6 * std::sqrt(r));
-    EXPECT_NEAR(runs[i].dt_s * std::sqrt(r) / runs[0].dt_s, 1.0, 0.08) << "ratio " << r;
-    if (r > 10) EXPECT_NEAR(runs[i].dt_s * std::sqrt(r / 10) / runs[1].dt_s, 1.0, 0.01) << "ratio " << r;
+    // The tumour's interior sets the bound from ratio 10 up: ω_max ∝ √ratio exactly, and dt ∝
+    // 1/√ratio up to the global damping γ (1%). At ratio 1 the block's edge and corner elements set
+    // it instead: hyperelastic elements carry the mass of their dual volume (¼ and ⅛ of a voxel
+    // there) while the Gershgorin bound counts all their connections, so their bound lies above the
+    // interior's √10-fold scaled-down value.
+    if (r >= 10) {
+      EXPECT_NEAR(runs[i].omega_max / runs[1].omega_max, std::sqrt(r / 10), 1e-6 * std::sqrt(r / 10));
+      EXPECT_NEAR(runs[i].dt_s * std::sqrt(r / 10) / runs[1].dt_s, 1.0, 0.01) << "ratio " << r;
+    } else {
+      EXPECT_GT(runs[0].omega_max, runs[1].omega_max / std::sqrt(10.0) * 1.1);
+    }
     // Physical sanity: a tenfold stiffer inclusion strains at least 3× less.
     if (i > 0) EXPECT_LT(runs[i].tumour_strain, runs[i - 1].tumour_strain / 3) << "ratio " << r;
     RecordProperty("ratio_" + std::to_string(int(r)), "dt " + std::to_string(runs[i].dt_s) + " s, steps " +
