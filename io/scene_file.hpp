@@ -6,12 +6,18 @@
 #include <vector>
 
 #include "engine/scene/scene.hpp"
+#include "io/scene_overrides.hpp"
 
 namespace vb {
 
 /// Reads and parses the scene file at `path`; Scene::source_path is `path`.
 /// Throws vb::Error when the file cannot be read or the scene is invalid.
 Scene parse_scene_file(const std::string& path);
+
+/// As parse_scene_file, with `overrides` (dotted keys, docs/SWEEP.md "Keys") applied to the file's
+/// text first; Scene::source_text is the edited text. Throws vb::Error naming the key when an
+/// override cannot be applied, and as parse_scene_file when the edited scene is invalid.
+Scene parse_scene_file(const std::string& path, const std::vector<SceneOverride>& overrides);
 
 /// Parses scene text; `source_name` (e.g. the file name) is used in error locations.
 /// Scene::source_text is `text`; Scene::source_path is left empty.
