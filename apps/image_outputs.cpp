@@ -8,6 +8,7 @@
 #include "io/dicom_io.hpp"
 #include "io/metaimage_io.hpp"
 #include "io/nifti_io.hpp"
+#include "io/scene_file.hpp"
 
 namespace vb::app {
 namespace {
@@ -23,10 +24,9 @@ std::vector<double> displacement_norm_mm(const FinalState& s) {
 
 /// A DVF as NIfTI (in the scene's layout) and as MetaImage; its statistics for summary.json.
 void write_dvf(const std::string& dir, const std::string& name, const ImageVolume& grid, const std::vector<float>& u,
-               const OutputSpec& want, nlohmann::json& written) {
+               const DvfFileOptions& files, nlohmann::json& written) {
   write_nifti_displacement(dir + "/" + name + ".nii.gz", grid, u,
-                           want.dvf_nifti == OutputSpec::DvfNifti::Legacy ? NiftiDisplacementLayout::VectorLps
-                                                                         : NiftiDisplacementLayout::DispVectRas);
+                           files.legacy_nifti ? NiftiDisplacementLayout::VectorLps : NiftiDisplacementLayout::DispVectRas);
   write_metaimage_displacement(dir + "/" + name + ".mha", grid, u);
   written[name] = name + ".nii.gz";
   written[name + "_mha"] = name + ".mha";
@@ -43,10 +43,11 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
   const OutputSpec& want = scene.output;
   nlohmann::json written = nlohmann::json::object();
   const LatticeField field(lattice, state.displacement_m);
-  if (want.dvf) write_dvf(dir, "dvf", ct, forward_displacement_on_grid(field, ct), want, written);
+  const DvfFileOptions files = dvf_file_options(scene);
+  if (want.dvf) write_dvf(dir, "dvf", ct, forward_displacement_on_grid(field, ct), files, written);
   if (want.dvf || want.warped_ct || want.warped_ct_dicom) {
     const WarpResult warp = warp_image(ct, lattice, state.displacement_m);
-    if (want.dvf) write_dvf(dir, "dvf_inverse", ct, warp.inverse_field, want, written);
+    if (want.dvf) write_dvf(dir, "dvf_inverse", ct, warp.inverse_field, files, written);
     if (want.warped_ct) {
       write_nifti(dir + "/warped_ct.nii.gz", warp.warped, NiftiType::Int16);
       written["warped_ct"] = "warped_ct.nii.gz";
@@ -59,7 +60,7 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
       // a rerun replaces its own earlier series
       const WrittenDicomSeries warped = replace_dicom_series(dir + "/warped_ct_dicom", warp.warped, series);
       written["warped_ct_dicom"] = "warped_ct_dicom/";
-      if (want.dvf_dicom) {
+      if (files.dicom) {
         write_dicom_deformable_registration(dir + "/dvf_inverse.dcm", ct, warp.inverse_field, ct, warped);
         written["dvf_inverse_dicom"] = "dvf_inverse.dcm";
       }

@@ -614,8 +614,7 @@ ReproducibilitySpec read_reproducibility(const Section& s, const std::vector<Anc
   return r;
 }
 
-const NameTable<OutputSpec::DvfNifti> kDvfNiftiLayouts = {{"standard", OutputSpec::DvfNifti::Standard, {}},
-                                                         {"legacy", OutputSpec::DvfNifti::Legacy, {}}};
+const NameTable<bool> kDvfNiftiLayouts = {{"standard", false, {}}, {"legacy", true, {}}};  // value: legacy
 
 OutputSpec read_output(const Section& s, const ModelSpec& model) {
   s.check_keys({"frames_every", "dvf", "dvf_nifti", "dvf_dicom", "warped_ct", "warped_ct_dicom", "fields", "surfaces"});
@@ -625,12 +624,11 @@ OutputSpec read_output(const Section& s, const ModelSpec& model) {
     if (s.find(key) && !model.from_image()) s.fail(key, "needs a CT image model (model.image)");
   }
   out.dvf = s.boolean("dvf").value_or(out.dvf);
-  if (const auto* n = s.named("dvf_nifti", kDvfNiftiLayouts)) out.dvf_nifti = n->value;
+  (void)s.named("dvf_nifti", kDvfNiftiLayouts);  // checked here, read by dvf_file_options
   if (s.find("dvf_nifti") && !out.dvf) s.fail("dvf_nifti", "sets the layout of the DVF files, but dvf = false writes none");
   out.warped_ct = s.boolean("warped_ct").value_or(out.warped_ct);
   out.warped_ct_dicom = s.boolean("warped_ct_dicom").value_or(out.warped_ct_dicom);
-  out.dvf_dicom = s.boolean("dvf_dicom").value_or(out.warped_ct_dicom);
-  if (out.dvf_dicom && !out.warped_ct_dicom)
+  if (s.boolean("dvf_dicom").value_or(false) && !out.warped_ct_dicom)
     s.fail("dvf_dicom", "the DICOM registration references the warped CT series, but warped_ct_dicom = false",
            "set warped_ct_dicom = true, or leave dvf_dicom out");
   out.fields = s.boolean("fields").value_or(out.fields);
@@ -723,6 +721,16 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
 const std::vector<std::string>& scene_path_keys() {
   static const std::vector<std::string> keys = {"model.image", "model.labels"};  // as resolve_paths
   return keys;
+}
+
+DvfFileOptions dvf_file_options(const Scene& scene) {
+  DvfFileOptions options;
+  const toml::table root = parse_toml_text(scene.source_text, scene.source_path);
+  const toml::table* output = root["output"].as_table();
+  if (!output) return options;
+  options.legacy_nifti = output->get_as<std::string>("dvf_nifti") && **output->get_as<std::string>("dvf_nifti") == "legacy";
+  options.dicom = (*output)["dvf_dicom"].value_or(scene.output.warped_ct_dicom) && scene.output.warped_ct_dicom;
+  return options;
 }
 
 Scene parse_scene_file(const std::string& path) { return parse_scene_file(path, {}); }

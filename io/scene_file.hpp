@@ -23,6 +23,15 @@ Scene parse_scene_file(const std::string& path, const std::vector<SceneOverride>
 /// Scene::source_text is `text`; Scene::source_path is left empty.
 Scene parse_scene_text(const std::string& text, const std::string& source_name);
 
+/// How an image model's DVF files are written: `[output]` dvf_nifti and dvf_dicom (docs/SCENE.md).
+struct DvfFileOptions {
+  bool legacy_nifti = false;  ///< NIfTI DVFs in ITK's legacy layout (intent 1007, LPS)
+  bool dicom = true;          ///< dvf_inverse.dcm (only with warped_ct_dicom)
+};
+
+/// The scene's DVF file options, read from its text (parse_scene_text has checked them).
+DvfFileOptions dvf_file_options(const Scene& scene);
+
 /// Dotted keys whose values are file paths, relative to the scene file's folder when relative
 /// (parse_scene_file resolves them): "model.image", "model.labels".
 const std::vector<std::string>& scene_path_keys();

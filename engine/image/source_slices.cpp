@@ -13,7 +13,7 @@ std::vector<std::pair<int, int>> source_slices_read(const ImageVolume& grid, con
   const int nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
   // The k index of y + d(y) is k + (row 2 of A⁻¹) · d(y): only d's part along that row moves it.
   const Eigen::RowVector3d k_per_m = grid.affine_lps_m.topLeftCorner<3, 3>().inverse().row(2);
-  std::vector<std::pair<int, int>> slices(std::size_t(nz));
+  std::vector<std::pair<int, int>> slices(static_cast<std::size_t>(nz));
   std::size_t v = 0;
   for (int k = 0; k < nz; ++k) {
     double low = k, high = k;

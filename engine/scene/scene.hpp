@@ -214,16 +214,9 @@ struct StopSpec {
 struct OutputSpec {
   int frames_every = 0;  ///< store displacement frames every N steps in result.h5 (0: none)
   // Image models only: results on the input CT's grid (docs/OUTPUTS.md).
-  bool dvf = true;              ///< dvf/dvf_inverse as .nii.gz and .mha (forward and inverse)
-  /// Vector layout of the NIfTI DVFs: the NIfTI standard's (intent 1006, RAS) or ITK's legacy one
-  /// (intent 1007, LPS) for tools built on ITK before 5.4. The .mha files are the same either way.
-  enum class DvfNifti { Standard, Legacy };
-  DvfNifti dvf_nifti = DvfNifti::Standard;
+  bool dvf = true;              ///< dvf.nii.gz (forward) and dvf_inverse.nii.gz
   bool warped_ct = true;        ///< warped_ct.nii.gz
   bool warped_ct_dicom = true;  ///< warped_ct_dicom/ series (new UIDs, patient/study copied)
-  /// dvf_inverse.dcm, a DICOM Deformable Spatial Registration referencing the warped CT series
-  /// (so written only with warped_ct_dicom)
-  bool dvf_dicom = true;
   bool fields = true;           ///< model_labels.nii.gz and per-element fields as NIfTI
   /// surface meshes (rest and deformed .vtp, .stl, .ply) and the lattice (.vtu): docs/OUTPUTS.md
   bool surfaces = false;
