@@ -7,6 +7,7 @@
 #include "apps/progress.hpp"
 #include "apps/simulation_pipeline.hpp"
 #include "io/atomic_file.hpp"
+#include "io/scene_file.hpp"
 #include "io/scene_overrides.hpp"
 
 namespace vb::app {
@@ -19,9 +20,11 @@ struct SimulateOptions {
 };
 
 int run_simulate(const SimulateOptions& o) {
-  std::vector<SceneOverride> overrides;
+  std::vector<SceneOverride> overrides;  // --set values, applied to the scene's text
   for (const std::string& s : o.settings) overrides.push_back(parse_scene_setting(s));
-  Scene scene = load_scene(o.scene, o.precision, overrides);
+  Scene scene = overrides.empty() ? load_scene(o.scene, o.precision) : parse_scene_file(o.scene, overrides);
+  if (!overrides.empty() && !o.precision.empty())
+    scene.solver.precision = o.precision == "double" ? Precision::Double : Precision::Float;
   if (!o.series.empty()) scene.model.series_uid = o.series;
   scene.model.allow_gaps = scene.model.allow_gaps || o.allow_gaps;
   const OutputDir output_dir(o.out);  // fail before computing, not after

@@ -13,8 +13,8 @@
 
 namespace vb::app {
 
-Scene load_scene(const std::string& path, const std::string& precision, const std::vector<SceneOverride>& overrides) {
-  Scene scene = parse_scene_file(path, overrides);
+Scene load_scene(const std::string& path, const std::string& precision) {
+  Scene scene = parse_scene_file(path);
   if (precision == "double") scene.solver.precision = Precision::Double;
   if (precision == "float") scene.solver.precision = Precision::Float;
   return scene;

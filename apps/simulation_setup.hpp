@@ -9,14 +9,11 @@
 #include "engine/scene/scene.hpp"
 #include "engine/sim/element_setup.hpp"
 #include "engine/sim/opencl_runtime.hpp"
-#include "io/scene_overrides.hpp"
 
 namespace vb::app {
 
-/// Parses the scene with `overrides` applied to its text (`simulate --set`); `precision` ("" keeps
-/// the scene's) overrides solver.precision.
-Scene load_scene(const std::string& path, const std::string& precision,
-                 const std::vector<SceneOverride>& overrides = {});
+/// Parses the scene; `precision` ("" keeps the scene's) overrides solver.precision.
+Scene load_scene(const std::string& path, const std::string& precision);
 
 struct PreparedModel {
   Lattice lattice;

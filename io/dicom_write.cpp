@@ -234,12 +234,10 @@ class DatasetWriter {
     check(data_.putAndInsertUint16Array(key, values.data(), values.size()), key);
   }
   void longs(const DcmTagKey& key, const std::vector<Uint32>& values) {
-    for (std::size_t n = 0; n < values.size(); ++n)
-      check(data_.putAndInsertUint32(key, values[n], unsigned(n)), key);
+    check(data_.putAndInsertUint32Array(key, values.data(), values.size()), key);
   }
   void doubles(const DcmTagKey& key, const std::vector<Float64>& values) {
-    for (std::size_t n = 0; n < values.size(); ++n)
-      check(data_.putAndInsertFloat64(key, values[n], unsigned(n)), key);
+    check(data_.putAndInsertFloat64Array(key, values.data(), values.size()), key);
   }
   void floats(const DcmTagKey& key, const std::vector<Float32>& values) {
     check(data_.putAndInsertFloat32Array(key, values.data(), values.size()), key);
@@ -557,6 +555,7 @@ void write_dicom_deformable_registration(const std::string& path, const ImageVol
   put.text(DCM_Modality, "REG");
   put.text(DCM_SeriesNumber, "9001");
   put.text(DCM_SeriesDescription, "VoxBreast deformation");
+  put.text(DCM_Laterality, "");
   put.text(DCM_SeriesDate, date);
   put.text(DCM_SeriesTime, time);
   put.text(DCM_InstanceCreationDate, date);
@@ -571,7 +570,7 @@ void write_dicom_deformable_registration(const std::string& path, const ImageVol
   put.text(DCM_ContentTime, time);
   put.text(DCM_InstanceNumber, "1");
   put.text(DCM_ContentLabel, "DVF_INVERSE");
-  put.text(DCM_ContentDescription, "VoxBreast simulated deformation: the source CT sampled at y + d(y) gives the warped CT");
+  put.text(DCM_ContentDescription, "Simulated deformation: source CT at y + d(y) = warped CT");  // LO: 64 characters
   put.text(DCM_ContentCreatorName, "");
   DatasetWriter registration(put.item(DCM_DeformableRegistrationSequence), path);
   registration.text(DCM_SourceFrameOfReferenceUID, source_frame);
