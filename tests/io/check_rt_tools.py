@@ -85,17 +85,16 @@ def plastimatch_warp(out, ct, xf, name):
 
 
 def transformix_warp(out, ct, xf, name):
-    field = nib.load(f"{out}/run/warped_ct.nii.gz")
     header, _ = read_mha(f"{out}/run/dvf_inverse.mha")
     folder = f"{out}/{name}"
     os.makedirs(folder)
-    # ITK's frame: the grid as in the .mha header (LPS mm), which equals the CT's.
+    # ITK's frame: the grid as in the .mha header (LPS mm), which equals the CT's. Linear
+    # interpolation is a B-spline of order 1: Debian's elastix 5.0.1 has no FinalLinearInterpolator.
     with open(f"{folder}/TransformParameters.txt", "w") as f:
         f.write(f"""(Transform "DeformationFieldTransform")
 (DeformationFieldFileName "{xf}")
 (DeformationFieldInterpolationOrder 1)
 (NumberOfParameters 0)
-(TransformParameters)
 (InitialTransformParametersFileName "NoInitialTransform")
 (HowToCombineTransforms "Compose")
 (FixedImageDimension 3)
@@ -108,14 +107,14 @@ def transformix_warp(out, ct, xf, name):
 (Origin {header["Offset"]})
 (Direction {" ".join(header["TransformMatrix"].split())})
 (UseDirectionCosines "true")
-(ResampleInterpolator "FinalLinearInterpolator")
+(ResampleInterpolator "FinalBSplineInterpolator")
+(FinalBSplineInterpolationOrder 1)
 (Resampler "DefaultResampler")
 (DefaultPixelValue -1000)
 (ResultImageFormat "nii.gz")
 (ResultImagePixelType "float")
 (CompressResultImage "false")
 """)
-    del field
     result = run(["transformix", "-in", ct, "-out", folder, "-tp", f"{folder}/TransformParameters.txt"])
     check(result.returncode == 0, f"transformix with {os.path.basename(xf)} exits 0")
     return f"{folder}/result.nii.gz"
