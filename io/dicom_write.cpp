@@ -259,15 +259,25 @@ class DatasetWriter {
   const std::string& path_;
 };
 
+/// The carried patient, study and frame attributes, and the type 2 ones among them empty when absent.
+void put_patient_and_study(DatasetWriter& put, const std::map<std::string, std::string>& carried) {
+  for (const auto& [key, value] : carried) put.text(*parse_tag_key(key), value);
+  for (const DcmTagKey& key : {DCM_PatientBirthDate, DCM_PatientSex, DCM_StudyDate, DCM_StudyTime,
+                               DCM_ReferringPhysicianName, DCM_StudyID, DCM_AccessionNumber})
+    if (!carried.count(tag_key_text(key))) put.text(key, "");
+}
+
+/// A dicom_tags value of the volume, "" when absent.
+std::string tag_of(const ImageVolume& volume, const char* key) {
+  const auto it = volume.dicom_tags.find(key);
+  return it == volume.dicom_tags.end() ? std::string() : it->second;
+}
+
 void write_slice(const std::string& path, const SeriesAttributes& series, const ImageVolume& ct,
                  int k) {
   DcmFileFormat file;
   DatasetWriter put(*file.getDataset(), path);
-  for (const auto& [key, value] : series.carried) put.text(*parse_tag_key(key), value);
-  // Type 2 attributes: present even when empty.
-  for (const DcmTagKey& key : {DCM_PatientBirthDate, DCM_PatientSex, DCM_StudyDate, DCM_StudyTime,
-                               DCM_ReferringPhysicianName, DCM_StudyID, DCM_AccessionNumber})
-    if (!series.carried.count(tag_key_text(key))) put.text(key, "");
+  put_patient_and_study(put, series.carried);
 
   put.text(DCM_SOPClassUID, UID_CTImageStorage);
   put.text(DCM_SOPInstanceUID, series.instance_uids[std::size_t(k)]);
@@ -451,12 +461,8 @@ SeriesAttributes series_attributes(const ImageVolume& ct, const std::string& dir
   series.derivation = "VoxBreast " + std::string(config::version) + " output" +
                       (source != ct.dicom_tags.end() ? " from series " + source->second : "");
   if (!options.source_slices.empty()) {
-    const auto tag = [&](const char* key) {
-      const auto it = ct.dicom_tags.find(key);
-      return it == ct.dicom_tags.end() ? std::string() : it->second;
-    };
-    series.source_sop_class = tag(kSourceSopClassKey);
-    series.source_instances = split_values(tag(kSourceInstancesKey));
+    series.source_sop_class = tag_of(ct, kSourceSopClassKey);
+    series.source_instances = split_values(tag_of(ct, kSourceInstancesKey));
     require(options.source_slices.size() == std::size_t(ct.dims[2]),
             "source slices are given for " + std::to_string(options.source_slices.size()) + " of " +
                 std::to_string(ct.dims[2]) + " slices",
@@ -534,10 +540,7 @@ void write_dicom_deformable_registration(const std::string& path, const ImageVol
   require(finite == displacement_lps_m.end(),
           "the displacement is not finite at voxel " + std::to_string((finite - displacement_lps_m.begin()) / 3), path);
   const WriteGeometry g = write_geometry(grid, path);
-  const auto tag = [&](const char* key) {
-    const auto it = source.dicom_tags.find(key);
-    return it == source.dicom_tags.end() ? std::string() : it->second;
-  };
+  const auto tag = [&](const char* key) { return tag_of(source, key); };
   const std::vector<std::string> source_instances = split_values(tag(kSourceInstancesKey));
   std::string source_frame = tag(tag_key_text(DCM_FrameOfReferenceUID).c_str());
   if (source_frame.empty()) source_frame = registered.frame_of_reference_uid;  // not from DICOM: same patient frame
@@ -545,10 +548,7 @@ void write_dicom_deformable_registration(const std::string& path, const ImageVol
 
   DcmFileFormat file;
   DatasetWriter put(*file.getDataset(), path);
-  for (const auto& [key, value] : registered.carried) put.text(*parse_tag_key(key), value);
-  for (const DcmTagKey& key : {DCM_PatientBirthDate, DCM_PatientSex, DCM_StudyDate, DCM_StudyTime,
-                               DCM_ReferringPhysicianName, DCM_StudyID, DCM_AccessionNumber})
-    if (!registered.carried.count(tag_key_text(key))) put.text(key, "");
+  put_patient_and_study(put, registered.carried);
   put.text(DCM_SOPClassUID, UID_DeformableSpatialRegistrationStorage);
   put.text(DCM_SOPInstanceUID, new_uid(SITE_INSTANCE_UID_ROOT));
   put.text(DCM_SeriesInstanceUID, new_uid(SITE_SERIES_UID_ROOT));
