@@ -7,6 +7,7 @@
 
 #include "apps/commands.hpp"
 #include "engine/image/breast_phantom.hpp"
+#include "engine/loads/posture.hpp"
 #include "io/atomic_file.hpp"
 #include "io/dicom_io.hpp"
 #include "io/nifti_io.hpp"
@@ -54,7 +55,11 @@ int run_phantom(const PhantomOptions& o) {
   const Phantom p = make_breast_phantom(spec);
   write_nifti(o.out + "/ct.nii.gz", p.ct, NiftiType::Int16);
   write_nifti(o.out + "/labels.nii.gz", p.labels, NiftiType::UInt8);
-  replace_dicom_series(o.out + "/dicom", p.ct, "VoxBreast synthetic breast phantom");
+  DicomSeriesOptions series;
+  series.series_description = "VoxBreast synthetic breast phantom";
+  series.patient_position = dicom_patient_position(gravity_for_posture("supine"));  // the phantom lies supine
+  series.deterministic = true;  // the same phantom always gives the same files, UIDs included
+  replace_dicom_series(o.out + "/dicom", p.ct, series);
   write_text_atomically(o.out + "/scene.toml", phantom_scene(p, spec));
   std::printf("phantom %d × %d × %d voxels of %.1f mm, seed %llu\nwrote %s/ct.nii.gz, labels.nii.gz, dicom/, scene.toml\n",
               p.ct.dims[0], p.ct.dims[1], p.ct.dims[2], o.spacing_mm, (unsigned long long)o.seed, o.out.c_str());

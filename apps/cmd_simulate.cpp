@@ -7,17 +7,24 @@
 #include "apps/progress.hpp"
 #include "apps/simulation_pipeline.hpp"
 #include "io/atomic_file.hpp"
+#include "io/scene_file.hpp"
+#include "io/scene_overrides.hpp"
 
 namespace vb::app {
 namespace {
 
 struct SimulateOptions {
   std::string scene, out, device, precision, series;
+  std::vector<std::string> settings;  ///< --set KEY=VALUE
   bool quiet = false, allow_gaps = false;
 };
 
 int run_simulate(const SimulateOptions& o) {
-  Scene scene = load_scene(o.scene, o.precision);
+  std::vector<SceneOverride> overrides;  // --set values, applied to the scene's text
+  for (const std::string& s : o.settings) overrides.push_back(parse_scene_setting(s));
+  Scene scene = overrides.empty() ? load_scene(o.scene, o.precision) : parse_scene_file(o.scene, overrides);
+  if (!overrides.empty() && !o.precision.empty())
+    scene.solver.precision = o.precision == "double" ? Precision::Double : Precision::Float;
   if (!o.series.empty()) scene.model.series_uid = o.series;
   scene.model.allow_gaps = scene.model.allow_gaps || o.allow_gaps;
   const OutputDir output_dir(o.out);  // fail before computing, not after
@@ -107,6 +114,9 @@ Command add_simulate(CLI::App& app) {
   sub->add_option("scene", o->scene, "scene file (TOML)")->required()->check(CLI::ExistingFile);
   sub->add_option("--out,-o", o->out, "output folder")->required();
   sub->add_option("--device,-d", o->device, "OpenCL device: gpu, cpu, an index or a name (default $VOXBREAST_DEVICE, else first GPU)");
+  sub->add_option("--set", o->settings, "KEY=VALUE: set one scene value by dotted key (materials.adipose.E=3000); "
+                                        "+KEY adds a key the scene lacks; repeatable (docs/SCENE.md)")
+      ->allow_extra_args(false);
   sub->add_option("--precision", o->precision, "override solver.precision")->check(CLI::IsMember({"float", "double"}));
   sub->add_option("--series", o->series, "DICOM SeriesInstanceUID when the CT folder holds several series");
   sub->add_flag("--allow-gaps", o->allow_gaps, "accept unevenly spaced DICOM slices (with a warning)");

@@ -3,8 +3,12 @@
 #include <cmath>
 
 #include "engine/image/deformation_field.hpp"
+#include "engine/image/displacement_stats.hpp"
+#include "engine/image/source_slices.hpp"
 #include "io/dicom_io.hpp"
+#include "io/metaimage_io.hpp"
 #include "io/nifti_io.hpp"
+#include "io/scene_file.hpp"
 
 namespace vb::app {
 namespace {
@@ -18,6 +22,20 @@ std::vector<double> displacement_norm_mm(const FinalState& s) {
   return out;
 }
 
+/// A DVF as NIfTI (in the scene's layout) and as MetaImage; its statistics for summary.json.
+void write_dvf(const std::string& dir, const std::string& name, const ImageVolume& grid, const std::vector<float>& u,
+               const DvfFileOptions& files, nlohmann::json& written) {
+  write_nifti_displacement(dir + "/" + name + ".nii.gz", grid, u,
+                           files.legacy_nifti ? NiftiDisplacementLayout::VectorLps : NiftiDisplacementLayout::DispVectRas);
+  write_metaimage_displacement(dir + "/" + name + ".mha", grid, u);
+  written[name] = name + ".nii.gz";
+  written[name + "_mha"] = name + ".mha";
+  const DisplacementStats s = displacement_stats(u);
+  written[name + "_stats_mm"] = {{"min", s.min_mm},           {"max", s.max_mm},
+                                 {"mean", s.mean_mm},         {"mean_abs", s.mean_abs_mm},
+                                 {"mean_length", s.mean_length_mm}, {"max_length", s.max_length_mm}};
+}
+
 }  // namespace
 
 nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, const Lattice& lattice,
@@ -25,23 +43,27 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
   const OutputSpec& want = scene.output;
   nlohmann::json written = nlohmann::json::object();
   const LatticeField field(lattice, state.displacement_m);
-  if (want.dvf) {
-    write_nifti_displacement(dir + "/dvf.nii.gz", ct, forward_displacement_on_grid(field, ct));
-    written["dvf"] = "dvf.nii.gz";
-  }
+  const DvfFileOptions files = dvf_file_options(scene);
+  if (want.dvf) write_dvf(dir, "dvf", ct, forward_displacement_on_grid(field, ct), files, written);
   if (want.dvf || want.warped_ct || want.warped_ct_dicom) {
     const WarpResult warp = warp_image(ct, lattice, state.displacement_m);
-    if (want.dvf) {
-      write_nifti_displacement(dir + "/dvf_inverse.nii.gz", ct, warp.inverse_field);
-      written["dvf_inverse"] = "dvf_inverse.nii.gz";
-    }
+    if (want.dvf) write_dvf(dir, "dvf_inverse", ct, warp.inverse_field, files, written);
     if (want.warped_ct) {
       write_nifti(dir + "/warped_ct.nii.gz", warp.warped, NiftiType::Int16);
       written["warped_ct"] = "warped_ct.nii.gz";
     }
     if (want.warped_ct_dicom) {
-      replace_dicom_series(dir + "/warped_ct_dicom", warp.warped, "VoxBreast warped CT");  // a rerun replaces its own earlier series
+      DicomSeriesOptions series;
+      series.series_description = "VoxBreast warped CT";
+      series.patient_position = dicom_patient_position(scene.gravity.active ? scene.gravity.acceleration_m_s2 : Vec3::Zero());
+      if (!ct.dicom_tags.empty()) series.source_slices = source_slices_read(ct, warp.inverse_field);
+      // a rerun replaces its own earlier series
+      const WrittenDicomSeries warped = replace_dicom_series(dir + "/warped_ct_dicom", warp.warped, series);
       written["warped_ct_dicom"] = "warped_ct_dicom/";
+      if (files.dicom) {
+        write_dicom_deformable_registration(dir + "/dvf_inverse.dcm", ct, warp.inverse_field, ct, warped);
+        written["dvf_inverse_dicom"] = "dvf_inverse.dcm";
+      }
     }
     written["warp_vacated_voxels"] = warp.vacated_voxels;
     written["warp_max_inversion_residual_m"] = warp.max_fixed_point_residual_m;

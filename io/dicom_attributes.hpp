@@ -24,6 +24,10 @@ extern const std::array<DcmTagKey, 13> kCarriedTags;
 
 /// ImageVolume::dicom_tags key of the source series' UID
 constexpr const char* kSourceSeriesKey = "source_series_uid";
+/// ImageVolume::dicom_tags keys of the source's SOPClassUID and of its slices' SOPInstanceUIDs in
+/// k order, joined by '\\' as a multi-valued attribute is
+constexpr const char* kSourceSopClassKey = "source_sop_class_uid";
+constexpr const char* kSourceInstancesKey = "source_instance_uids";
 constexpr const char* kCorruptFileHint = "the file may be truncated or corrupt; remove or replace it";
 
 /// "gggg,eeee" in upper-case hex, as the standard prints tags.

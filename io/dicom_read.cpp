@@ -349,6 +349,11 @@ ImageVolume read_series(const std::string& dir, const DicomReadOptions& options,
     read_slice_pixels(stack.files[std::size_t(k)]->path, stack.rows, stack.columns,
                       &volume.values[volume.linear_index(0, 0, k)]);
   carry_tags(stack.files.front()->data(), volume);
+  volume.dicom_tags[kSourceSopClassKey] = get_text(stack.files.front()->data(), DCM_SOPClassUID);
+  std::string instances;
+  for (const DicomHeader* file : stack.files)
+    instances += (instances.empty() ? "" : "\\") + get_text(file->data(), DCM_SOPInstanceUID);
+  volume.dicom_tags[kSourceInstancesKey] = instances;
   if (warnings) warnings->insert(warnings->end(), stack_warnings.begin(), stack_warnings.end());
   return volume;
 }

@@ -4,6 +4,10 @@
 #include <dcmtk/dcmdata/dcdeftag.h>
 #include <dcmtk/dcmdata/dcfilefo.h>
 #include <dcmtk/dcmdata/dcuid.h>
+#include <dcmtk/dcmdata/dcvrda.h>
+#include <dcmtk/dcmdata/dcvrtm.h>
+#include <dcmtk/ofstd/ofuuid.h>
+#include <openssl/evp.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -14,6 +18,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <tuple>
 
 #include "engine/error.hpp"
 #include "io/atomic_file.hpp"
@@ -113,24 +118,104 @@ std::string new_uid(const char* root) {
   return dcmGenerateUniqueIdentifier(uid, root);
 }
 
+/// An OpenSSL message digest fed piece by piece.
+class Digest {
+ public:
+  explicit Digest(const EVP_MD* kind) : context_(EVP_MD_CTX_new()) {
+    require(context_ && EVP_DigestInit_ex(context_, kind, nullptr) == 1, "cannot start an OpenSSL digest");
+  }
+  ~Digest() { EVP_MD_CTX_free(context_); }
+  Digest(const Digest&) = delete;
+  Digest& operator=(const Digest&) = delete;
+  void add(const void* data, std::size_t bytes) { EVP_DigestUpdate(context_, data, bytes); }
+  std::string finish() {
+    unsigned char bytes[EVP_MAX_MD_SIZE];
+    unsigned int size = 0;
+    EVP_DigestFinal_ex(context_, bytes, &size);
+    return std::string(reinterpret_cast<const char*>(bytes), size);
+  }
+
+ private:
+  EVP_MD_CTX* context_;
+};
+
+/// SHA-256 of the volume: what a deterministic series' UIDs are derived from.
+std::string content_digest(const ImageVolume& ct, const std::string& description) {
+  Digest sha(EVP_sha256());
+  sha.add(description.data(), description.size());
+  sha.add(ct.dims.data(), sizeof ct.dims);
+  sha.add(ct.affine_lps_m.data(), sizeof(double) * 16);
+  sha.add(ct.values.data(), sizeof(float) * ct.values.size());
+  return sha.finish();
+}
+
+/// A name-based (SHA-1, version 5) UUID of `name` as a DICOM UID under the 2.25 root
+/// (PS3.5 B.2): the same name always gives the same UID.
+std::string name_based_uid(const std::string& name) {
+  // RFC 4122 version 5 in VoxBreast's own namespace (a fixed random UUID).
+  static const unsigned char kNamespace[16] = {0x3c, 0x8e, 0x52, 0x0b, 0x9d, 0x41, 0x4f, 0x6a,
+                                               0xa7, 0x1e, 0x0c, 0x55, 0xd2, 0x93, 0x68, 0xf4};
+  Digest sha1(EVP_sha1());
+  sha1.add(kNamespace, sizeof kNamespace);
+  sha1.add(name.data(), name.size());
+  const std::string digest = sha1.finish();
+  OFUUID::BinaryRepresentation bytes;
+  std::copy(digest.begin(), digest.begin() + 16, bytes.value);
+  bytes.value[6] = Uint8((bytes.value[6] & 0x0f) | 0x50);  // version 5
+  bytes.value[8] = Uint8((bytes.value[8] & 0x3f) | 0x80);  // RFC 4122 variant
+  OFString text;
+  return OFUUID(bytes).toString(text, OFUUID::ER_RepresentationOID).c_str();
+}
+
+/// Fresh UIDs, or (deterministic) UIDs named after the volume's content and the UID's role.
+class UidSource {
+ public:
+  UidSource(bool deterministic, const ImageVolume& ct, const std::string& description)
+      : digest_(deterministic ? content_digest(ct, description) : std::string()) {}
+  std::string operator()(const char* root, const std::string& role) const {
+    return digest_.empty() ? new_uid(root) : name_based_uid(digest_ + role);
+  }
+
+ private:
+  std::string digest_;
+};
+
+/// DICOM date and time (DA, TM) of now, local time as DICOM expects.
+std::pair<std::string, std::string> now_date_time() {
+  OFString date, time;
+  DcmDate::getCurrentDate(date);
+  DcmTime::getCurrentTime(time, true, false);
+  return {date.c_str(), time.c_str()};
+}
+
 /// Attributes shared by every slice of the written series.
 struct SeriesAttributes {
   std::map<std::string, std::string> carried;  ///< "gggg,eeee" → value
-  std::string series_uid, series_description, derivation;
+  std::string series_uid, series_description, derivation, patient_position;
+  std::string date, time;  ///< of writing; empty for a deterministic series
+  std::vector<std::string> instance_uids;  ///< per slice
+  std::string source_sop_class;
+  std::vector<std::string> source_instances;          ///< per source slice
+  std::vector<std::pair<int, int>> source_slices;     ///< per written slice: source slices used
   Rescale rescale;
   WriteGeometry geometry;
 };
 
-std::map<std::string, std::string> carried_attributes(const ImageVolume& ct) {
+std::map<std::string, std::string> carried_attributes(const ImageVolume& ct, const UidSource& uid,
+                                                      const std::string& date, const std::string& time) {
   std::map<std::string, std::string> carried;
   for (const auto& [key, value] : ct.dicom_tags) {
     const auto tag = parse_tag_key(key);
     if (tag && std::find(kCarriedTags.begin(), kCarriedTags.end(), *tag) != kCarriedTags.end())
       carried[tag_key_text(*tag)] = value;
   }
-  // Without a source study (NIfTI, phantom) the series starts its own study and frame.
-  carried.try_emplace(tag_key_text(DCM_StudyInstanceUID), new_uid(SITE_STUDY_UID_ROOT));
-  carried.try_emplace(tag_key_text(DCM_FrameOfReferenceUID), new_uid(SITE_INSTANCE_UID_ROOT));
+  // Without a source study (NIfTI, phantom) the series starts its own study and frame, now.
+  if (!carried.count(tag_key_text(DCM_StudyInstanceUID))) {
+    carried[tag_key_text(DCM_StudyInstanceUID)] = uid(SITE_STUDY_UID_ROOT, "/study");
+    carried.try_emplace(tag_key_text(DCM_StudyDate), date);
+    carried.try_emplace(tag_key_text(DCM_StudyTime), time);
+  }
+  carried.try_emplace(tag_key_text(DCM_FrameOfReferenceUID), uid(SITE_INSTANCE_UID_ROOT, "/frame"));
   carried.try_emplace(tag_key_text(DCM_PatientName), "VoxBreast^Phantom");
   carried.try_emplace(tag_key_text(DCM_PatientID), "VOXBREAST");
   return carried;
@@ -138,7 +223,7 @@ std::map<std::string, std::string> carried_attributes(const ImageVolume& ct) {
 
 class DatasetWriter {
  public:
-  DatasetWriter(DcmDataset& data, const std::string& path) : data_(data), path_(path) {}
+  DatasetWriter(DcmItem& data, const std::string& path) : data_(data), path_(path) {}
   void text(const DcmTagKey& key, const std::string& value) {
     check(data_.putAndInsertOFStringArray(key, value.c_str()), key);
   }
@@ -148,32 +233,65 @@ class DatasetWriter {
   void words(const DcmTagKey& key, const std::vector<Uint16>& values) {
     check(data_.putAndInsertUint16Array(key, values.data(), values.size()), key);
   }
+  void longs(const DcmTagKey& key, const std::vector<Uint32>& values) {
+    check(data_.putAndInsertUint32Array(key, values.data(), values.size()), key);
+  }
+  void doubles(const DcmTagKey& key, const std::vector<Float64>& values) {
+    check(data_.putAndInsertFloat64Array(key, values.data(), values.size()), key);
+  }
+  void floats(const DcmTagKey& key, const std::vector<Float32>& values) {
+    check(data_.putAndInsertFloat32Array(key, values.data(), values.size()), key);
+  }
+  /// Sequence `key` with no items (a type 2 sequence with nothing to say).
+  void empty_sequence(const DcmTagKey& key) { check(data_.insertEmptyElement(key), key); }
+  /// A new item at the end of sequence `key`.
+  DcmItem& item(const DcmTagKey& key) {
+    DcmItem* added = nullptr;
+    check(data_.findOrCreateSequenceItem(key, added, -2), key);
+    return *added;
+  }
 
  private:
   void check(const OFCondition& status, const DcmTagKey& key) {
     require(status.good(), "cannot set " + tag_name(key) + ": " + status.text(), path_);
   }
-  DcmDataset& data_;
+  DcmItem& data_;
   const std::string& path_;
 };
+
+/// The carried patient, study and frame attributes, and the type 2 ones among them empty when absent.
+void put_patient_and_study(DatasetWriter& put, const std::map<std::string, std::string>& carried) {
+  for (const auto& [key, value] : carried) put.text(*parse_tag_key(key), value);
+  for (const DcmTagKey& key : {DCM_PatientBirthDate, DCM_PatientSex, DCM_StudyDate, DCM_StudyTime,
+                               DCM_ReferringPhysicianName, DCM_StudyID, DCM_AccessionNumber})
+    if (!carried.count(tag_key_text(key))) put.text(key, "");
+}
+
+/// A dicom_tags value of the volume, "" when absent.
+std::string tag_of(const ImageVolume& volume, const char* key) {
+  const auto it = volume.dicom_tags.find(key);
+  return it == volume.dicom_tags.end() ? std::string() : it->second;
+}
 
 void write_slice(const std::string& path, const SeriesAttributes& series, const ImageVolume& ct,
                  int k) {
   DcmFileFormat file;
   DatasetWriter put(*file.getDataset(), path);
-  for (const auto& [key, value] : series.carried) put.text(*parse_tag_key(key), value);
-  // Type 2 attributes: present even when empty.
-  for (const DcmTagKey& key : {DCM_PatientBirthDate, DCM_PatientSex, DCM_StudyDate, DCM_StudyTime,
-                               DCM_ReferringPhysicianName, DCM_StudyID, DCM_AccessionNumber})
-    if (!series.carried.count(tag_key_text(key))) put.text(key, "");
+  put_patient_and_study(put, series.carried);
 
   put.text(DCM_SOPClassUID, UID_CTImageStorage);
-  put.text(DCM_SOPInstanceUID, new_uid(SITE_INSTANCE_UID_ROOT));
+  put.text(DCM_SOPInstanceUID, series.instance_uids[std::size_t(k)]);
   put.text(DCM_SeriesInstanceUID, series.series_uid);
   put.text(DCM_Modality, "CT");
   put.text(DCM_SeriesNumber, "9000");
   put.text(DCM_SeriesDescription, series.series_description);
-  put.text(DCM_ImageType, "DERIVED\\SECONDARY");
+  put.text(DCM_PatientPosition, series.patient_position);
+  put.text(DCM_Laterality, "");  // a breast CT may show both sides: unknown
+  if (!series.date.empty()) {
+    for (const DcmTagKey& key : {DCM_SeriesDate, DCM_ContentDate, DCM_InstanceCreationDate}) put.text(key, series.date);
+    for (const DcmTagKey& key : {DCM_SeriesTime, DCM_ContentTime, DCM_InstanceCreationTime}) put.text(key, series.time);
+  }
+  put.text(DCM_ImageType, "DERIVED\\SECONDARY\\AXIAL");
   put.text(DCM_DerivationDescription, series.derivation);
   put.text(DCM_Manufacturer, "VoxBreast");
   put.text(DCM_SoftwareVersions, config::version);
@@ -181,6 +299,18 @@ void write_slice(const std::string& path, const SeriesAttributes& series, const 
   put.text(DCM_KVP, "");
   put.text(DCM_AcquisitionNumber, "");
   put.text(DCM_InstanceNumber, std::to_string(k + 1));
+  if (!series.source_slices.empty()) {
+    const auto [first, last] = series.source_slices[std::size_t(k)];
+    for (int source = first; source <= last; ++source) {
+      DatasetWriter reference(put.item(DCM_SourceImageSequence), path);
+      reference.text(DCM_ReferencedSOPClassUID, series.source_sop_class);
+      reference.text(DCM_ReferencedSOPInstanceUID, series.source_instances[std::size_t(source)]);
+      DatasetWriter purpose(reference.item(DCM_PurposeOfReferenceCodeSequence), path);
+      purpose.text(DCM_CodeValue, "121322");
+      purpose.text(DCM_CodingSchemeDesignator, "DCM");
+      purpose.text(DCM_CodeMeaning, "Source image for image processing operation");
+    }
+  }
 
   const WriteGeometry& g = series.geometry;
   const Eigen::Vector3d position = g.origin_mm + double(k) * g.slice_step_mm;
@@ -204,6 +334,9 @@ void write_slice(const std::string& path, const SeriesAttributes& series, const 
   put.text(DCM_RescaleIntercept, ds_text(series.rescale.intercept));
   put.text(DCM_RescaleSlope, ds_text(series.rescale.slope));
   put.text(DCM_RescaleType, "HU");
+  put.text(DCM_WindowCenter, "40");  // a soft-tissue window: the breast's fat and gland apart
+  put.text(DCM_WindowWidth, "400");
+  put.text(DCM_WindowCenterWidthExplanation, "SOFT TISSUE");
   const std::size_t slice_voxels = std::size_t(ct.dims[0]) * std::size_t(ct.dims[1]);
   put.words(DCM_PixelData,
             stored_pixels(&ct.values[ct.linear_index(0, 0, k)], slice_voxels, series.rescale));
@@ -299,53 +432,210 @@ bool check_own_series_folder(const fs::path& path, const std::string& dir) {
   return true;
 }
 
-/// The new series' attributes: geometry, rescale, carried patient and study, fresh UIDs.
-SeriesAttributes series_attributes(const ImageVolume& ct, const std::string& dir,
-                                   const std::string& series_description) {
+std::vector<std::string> split_values(const std::string& text) {
+  std::vector<std::string> values;
+  std::size_t begin = 0;
+  while (!text.empty()) {
+    const std::size_t end = text.find('\\', begin);
+    values.push_back(text.substr(begin, end - begin));
+    if (end == std::string::npos) break;
+    begin = end + 1;
+  }
+  return values;
+}
+
+/// The new series' attributes: geometry, rescale, carried patient and study, UIDs, references.
+SeriesAttributes series_attributes(const ImageVolume& ct, const std::string& dir, const DicomSeriesOptions& options) {
   SeriesAttributes series;
   series.geometry = write_geometry(ct, dir);
   series.rescale = choose_rescale(ct.values, dir);
-  series.carried = carried_attributes(ct);
-  series.series_uid = new_uid(SITE_SERIES_UID_ROOT);
-  series.series_description = series_description;
+  const UidSource uid(options.deterministic, ct, options.series_description);
+  if (!options.deterministic) std::tie(series.date, series.time) = now_date_time();
+  series.carried = carried_attributes(ct, uid, series.date, series.time);
+  series.series_uid = uid(SITE_SERIES_UID_ROOT, "/series");
+  for (int k = 0; k < ct.dims[2]; ++k)
+    series.instance_uids.push_back(uid(SITE_INSTANCE_UID_ROOT, "/instance/" + std::to_string(k)));
+  series.series_description = options.series_description;
+  series.patient_position = options.patient_position;
   const auto source = ct.dicom_tags.find(kSourceSeriesKey);
   series.derivation = "VoxBreast " + std::string(config::version) + " output" +
                       (source != ct.dicom_tags.end() ? " from series " + source->second : "");
+  if (!options.source_slices.empty()) {
+    series.source_sop_class = tag_of(ct, kSourceSopClassKey);
+    series.source_instances = split_values(tag_of(ct, kSourceInstancesKey));
+    require(options.source_slices.size() == std::size_t(ct.dims[2]),
+            "source slices are given for " + std::to_string(options.source_slices.size()) + " of " +
+                std::to_string(ct.dims[2]) + " slices",
+            dir);
+    require(!series.source_sop_class.empty() && !series.source_instances.empty(),
+            "source slices are given, but the volume was not read from a DICOM series", dir);
+    for (const auto& [first, last] : options.source_slices)
+      require(0 <= first && first <= last && std::size_t(last) < series.source_instances.size(),
+              "source slices " + std::to_string(first) + ".." + std::to_string(last) + " lie outside the source's " +
+                  std::to_string(series.source_instances.size()) + " slices",
+              dir);
+    series.source_slices = options.source_slices;
+  }
   return series;
 }
 
-void write_slices(const StagingFolder& staging, const ImageVolume& ct, const std::string& dir,
-                  const std::string& series_description) {
-  const SeriesAttributes series = series_attributes(ct, dir, series_description);
+WrittenDicomSeries write_slices(const StagingFolder& staging, const ImageVolume& ct, const std::string& dir,
+                                const DicomSeriesOptions& options) {
+  const SeriesAttributes series = series_attributes(ct, dir, options);
   for (int k = 0; k < ct.dims[2]; ++k)
     write_slice((staging.path() / slice_file_name(k)).string(), series, ct, k);
+  WrittenDicomSeries written;
+  written.study_uid = series.carried.at(tag_key_text(DCM_StudyInstanceUID));
+  written.frame_of_reference_uid = series.carried.at(tag_key_text(DCM_FrameOfReferenceUID));
+  written.series_uid = series.series_uid;
+  written.sop_class_uid = UID_CTImageStorage;
+  written.instance_uids = series.instance_uids;
+  written.carried = series.carried;
+  return written;
+}
+
+DicomSeriesOptions described(const std::string& series_description) {
+  DicomSeriesOptions options;
+  options.series_description = series_description;
+  return options;
 }
 
 }  // namespace
 
-void write_dicom_series(const std::string& dir, const ImageVolume& ct,
-                        const std::string& series_description) {
+std::string dicom_patient_position(const Eigen::Vector3d& gravity_lps) {
+  if (gravity_lps.norm() == 0) return "";
+  Eigen::Index axis = 0;
+  gravity_lps.cwiseAbs().maxCoeff(&axis);
+  const bool positive = gravity_lps[axis] > 0;
+  switch (axis) {
+    case 0: return positive ? "HFDL" : "HFDR";  // towards the patient's left: lying on the left side
+    case 1: return positive ? "HFS" : "HFP";    // towards the back: supine
+    default: return "";                          // along the body: upright or head down
+  }
+}
+
+WrittenDicomSeries write_dicom_series(const std::string& dir, const ImageVolume& ct, const DicomSeriesOptions& options) {
   init_dcmtk();
   check_writable(ct, dir);
   StagingFolder staging(clean_output_path(dir));
-  write_slices(staging, ct, dir, series_description);
+  WrittenDicomSeries written = write_slices(staging, ct, dir, options);
   staging.commit();
+  return written;
+}
+
+void write_dicom_series(const std::string& dir, const ImageVolume& ct,
+                        const std::string& series_description) {
+  write_dicom_series(dir, ct, described(series_description));
+}
+
+void write_dicom_deformable_registration(const std::string& path, const ImageVolume& grid,
+                                         const std::vector<float>& displacement_lps_m,
+                                         const ImageVolume& source, const WrittenDicomSeries& registered) {
+  init_dcmtk();
+  require(displacement_lps_m.size() == 3 * grid.voxel_count(),
+          "displacement has " + std::to_string(displacement_lps_m.size()) + " floats for " +
+              std::to_string(grid.voxel_count()) + " voxels (3 per voxel expected)",
+          path);
+  const auto finite = std::find_if(displacement_lps_m.begin(), displacement_lps_m.end(), [](float v) { return !std::isfinite(v); });
+  require(finite == displacement_lps_m.end(),
+          "the displacement is not finite at voxel " + std::to_string((finite - displacement_lps_m.begin()) / 3), path);
+  const WriteGeometry g = write_geometry(grid, path);
+  const auto tag = [&](const char* key) { return tag_of(source, key); };
+  const std::vector<std::string> source_instances = split_values(tag(kSourceInstancesKey));
+  std::string source_frame = tag(tag_key_text(DCM_FrameOfReferenceUID).c_str());
+  if (source_frame.empty()) source_frame = registered.frame_of_reference_uid;  // not from DICOM: same patient frame
+  const auto [date, time] = now_date_time();
+
+  DcmFileFormat file;
+  DatasetWriter put(*file.getDataset(), path);
+  put_patient_and_study(put, registered.carried);
+  put.text(DCM_SOPClassUID, UID_DeformableSpatialRegistrationStorage);
+  put.text(DCM_SOPInstanceUID, new_uid(SITE_INSTANCE_UID_ROOT));
+  put.text(DCM_SeriesInstanceUID, new_uid(SITE_SERIES_UID_ROOT));
+  put.text(DCM_Modality, "REG");
+  put.text(DCM_SeriesNumber, "9001");
+  put.text(DCM_SeriesDescription, "VoxBreast deformation");
+  put.text(DCM_Laterality, "");
+  put.text(DCM_SeriesDate, date);
+  put.text(DCM_SeriesTime, time);
+  put.text(DCM_InstanceCreationDate, date);
+  put.text(DCM_InstanceCreationTime, time);
+  put.text(DCM_PositionReferenceIndicator, "");
+  put.text(DCM_Manufacturer, "VoxBreast");
+  put.text(DCM_ManufacturerModelName, "VoxBreast");
+  put.text(DCM_DeviceSerialNumber, config::git_commit);
+  put.text(DCM_SoftwareVersions, config::version);
+  // Content: the deformation, from the registered frame (the warped CT) into the source CT.
+  put.text(DCM_ContentDate, date);
+  put.text(DCM_ContentTime, time);
+  put.text(DCM_InstanceNumber, "1");
+  put.text(DCM_ContentLabel, "DVF_INVERSE");
+  put.text(DCM_ContentDescription, "Simulated deformation: source CT at y + d(y) = warped CT");  // LO: 64 characters
+  put.text(DCM_ContentCreatorName, "");
+  DatasetWriter registration(put.item(DCM_DeformableRegistrationSequence), path);
+  registration.text(DCM_SourceFrameOfReferenceUID, source_frame);
+  for (const std::string& instance : source_instances) {
+    DatasetWriter reference(registration.item(DCM_ReferencedImageSequence), path);
+    reference.text(DCM_ReferencedSOPClassUID, tag(kSourceSopClassKey));
+    reference.text(DCM_ReferencedSOPInstanceUID, instance);
+  }
+  registration.text(DCM_FrameOfReferenceTransformationComment,
+                    "VoxBreast " + std::string(config::version) + " biomechanical simulation (dvf_inverse)");
+  registration.empty_sequence(DCM_RegistrationTypeCodeSequence);
+  DcmItem& grid_item = registration.item(DCM_DeformableRegistrationGridSequence);
+  DatasetWriter put_grid(grid_item, path);
+  Eigen::Matrix<double, 6, 1> cosines;
+  cosines << g.row_direction, g.column_direction;
+  put_grid.text(DCM_ImagePositionPatient, ds_list(g.origin_mm));
+  put_grid.text(DCM_ImageOrientationPatient, ds_list(cosines));
+  put_grid.longs(DCM_GridDimensions, {Uint32(grid.dims[0]), Uint32(grid.dims[1]), Uint32(grid.dims[2])});
+  put_grid.doubles(DCM_GridResolution, {g.column_spacing_mm, g.row_spacing_mm, g.slice_step_mm.norm()});
+  std::vector<Float32> vectors_mm(displacement_lps_m.size());
+  for (std::size_t n = 0; n < vectors_mm.size(); ++n) vectors_mm[n] = Float32(1e3 * double(displacement_lps_m[n]));
+  put_grid.floats(DCM_VectorGridData, vectors_mm);
+  // Common Instance Reference: the source's series and the warped CT's.
+  if (!source_instances.empty()) {
+    DatasetWriter series(put.item(DCM_ReferencedSeriesSequence), path);
+    series.text(DCM_SeriesInstanceUID, tag(kSourceSeriesKey));
+    for (const std::string& instance : source_instances) {
+      DatasetWriter reference(series.item(DCM_ReferencedInstanceSequence), path);
+      reference.text(DCM_ReferencedSOPClassUID, tag(kSourceSopClassKey));
+      reference.text(DCM_ReferencedSOPInstanceUID, instance);
+    }
+  }
+  DatasetWriter warped(put.item(DCM_ReferencedSeriesSequence), path);
+  warped.text(DCM_SeriesInstanceUID, registered.series_uid);
+  for (const std::string& instance : registered.instance_uids) {
+    DatasetWriter reference(warped.item(DCM_ReferencedInstanceSequence), path);
+    reference.text(DCM_ReferencedSOPClassUID, registered.sop_class_uid);
+    reference.text(DCM_ReferencedSOPInstanceUID, instance);
+  }
+
+  AtomicOutput output(path);
+  const OFCondition status = file.saveFile(output.temp_path().c_str(), EXS_LittleEndianExplicit);
+  require(status.good(), std::string("cannot write DICOM file: ") + status.text(), path);
+  output.commit();
 }
 
 void check_dicom_series_replaceable(const std::string& dir) { check_own_series_folder(normal_output_path(dir), dir); }
 
 void replace_dicom_series(const std::string& dir, const ImageVolume& ct,
                           const std::string& series_description) {
+  replace_dicom_series(dir, ct, described(series_description));
+}
+
+WrittenDicomSeries replace_dicom_series(const std::string& dir, const ImageVolume& ct,
+                                        const DicomSeriesOptions& options) {
   init_dcmtk();
   check_writable(ct, dir);
   const fs::path final_dir = normal_output_path(dir);
   const bool earlier = check_own_series_folder(final_dir, dir);
   ensure_output_dir(final_dir.parent_path().string());
   StagingFolder staging(final_dir);
-  write_slices(staging, ct, dir, series_description);
+  WrittenDicomSeries written = write_slices(staging, ct, dir, options);
   if (!earlier) {
     staging.commit();
-    return;
+    return written;
   }
   // Swap by two renames, so the folder never holds slices of both series; the old one goes last.
   const fs::path old_dir = final_dir.parent_path() / ("." + final_dir.filename().string() + ".old-" +
@@ -363,6 +653,7 @@ void replace_dicom_series(const std::string& dir, const ImageVolume& ct,
   fs::remove_all(old_dir, ec);
   require(!ec, "the new series is in place, but the earlier one could not be removed: " + ec.message(),
           old_dir.string());
+  return written;
 }
 
 }  // namespace vb

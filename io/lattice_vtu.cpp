@@ -6,6 +6,20 @@
 #include "io/vtk_xml_arrays.hpp"
 
 namespace vb {
+namespace {
+
+/// One Int32 field-data array per tissue, named by the tissue and holding its `tissue` value:
+/// numbers, which meshio reads as well as VTK (meshio refuses VTK's String arrays). No SPACE
+/// string either, for the same reason: 3D Slicer reads a file without it as LPS, its default.
+std::string tissue_field_data(const std::vector<std::string>& tissue_names) {
+  std::string out = "<FieldData>\n";
+  for (std::size_t t = 0; t < tissue_names.size(); ++t)
+    out += "<Array type=\"Int32\" Name=\"" + vtk_xml::escape_attribute(tissue_names[t]) +
+           "\" NumberOfTuples=\"1\" format=\"ascii\">" + std::to_string(t) + "</Array>\n";
+  return out + "</FieldData>\n";
+}
+
+}  // namespace
 
 void write_lattice_vtu(const std::string& path, const Lattice& lattice, std::span<const double> positions_m,
                        std::span<const double> displacement_m, const std::vector<ElementField>& fields) {
@@ -35,10 +49,10 @@ void write_lattice_vtu(const std::string& path, const Lattice& lattice, std::spa
   using vtk_xml::data_array;
   std::string xml =
       "<?xml version=\"1.0\"?>\n"
-      "<!-- VoxBreast lattice: elements as points, complete dual cells as hexahedra; DICOM LPS, mm -->\n"
+      "<!-- VoxBreast lattice: elements as points, complete dual cells as hexahedra; SPACE=LPS, mm -->\n"
       "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
       "<UnstructuredGrid>\n" +
-      vtk_xml::field_data(lattice.tissue_names) + "<Piece NumberOfPoints=\"" + std::to_string(n) +
+      tissue_field_data(lattice.tissue_names) + "<Piece NumberOfPoints=\"" + std::to_string(n) +
       "\" NumberOfCells=\"" + std::to_string(offsets.size()) + "\">\n<PointData Vectors=\"displacement_mm\">\n" +
       data_array("displacement_mm", 3, displacement) + data_array("tissue", 1, tissue);
   for (const ElementField& f : fields) xml += data_array(f.name, f.components, std::vector<double>(f.values.begin(), f.values.end()));

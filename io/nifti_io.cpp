@@ -609,7 +609,7 @@ void write_nifti(const std::string& path, const ImageVolume& image, NiftiType ty
 }
 
 void write_nifti_displacement(const std::string& path, const ImageVolume& grid,
-                              const std::vector<float>& displacement_lps_m) {
+                              const std::vector<float>& displacement_lps_m, NiftiDisplacementLayout layout) {
   const std::size_t n = grid.voxel_count();
   require(displacement_lps_m.size() == kVectorComponents * n,
           "displacement has " + std::to_string(displacement_lps_m.size()) + " floats for " +
@@ -617,16 +617,18 @@ void write_nifti_displacement(const std::string& path, const ImageVolume& grid,
           path);
   NiftiPtr nim = new_image(grid.dims, int(kVectorComponents), NIFTI_TYPE_FLOAT32, path);
   set_geometry(*nim, grid.affine_lps_m, path);
-  nim->intent_code = NIFTI_INTENT_DISPVECT;
+  const bool ras = layout == NiftiDisplacementLayout::DispVectRas;
+  nim->intent_code = ras ? NIFTI_INTENT_DISPVECT : NIFTI_INTENT_VECTOR;
   set_text(nim->intent_name, sizeof nim->intent_name, "displacement");
-  set_text(nim->descrip, sizeof nim->descrip, "VoxBreast displacement u: x -> x + u(x), RAS mm");
-  // NIfTI stores the component axis slowest (dim[5]); components in the file's RAS frame, mm.
+  set_text(nim->descrip, sizeof nim->descrip,
+           ras ? "VoxBreast displacement u: x -> x + u(x), RAS mm" : "VoxBreast displacement u: x -> x + u(x), LPS mm");
+  // NIfTI stores the component axis slowest (dim[5]); components in mm, RAS or LPS by layout.
   auto* out = static_cast<float*>(nim->data);
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t c = 0; c < kVectorComponents; ++c) {
       const float u = displacement_lps_m[kVectorComponents * i + c];
       require(std::isfinite(u), "displacement is not finite at " + voxel_name(grid.dims, i), path);
-      out[c * n + i] = float(kLpsRasSign[c] * double(u) / kMetresPerMm);
+      out[c * n + i] = float((ras ? kLpsRasSign[c] : 1.0) * double(u) / kMetresPerMm);
     }
   }
   write_file(path, *nim);

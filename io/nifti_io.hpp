@@ -32,13 +32,23 @@ enum class NiftiType { Int16, UInt8, Float32 };
 /// written with intent NIFTI_INTENT_LABEL. The file appears atomically (AtomicOutput).
 void write_nifti(const std::string& path, const ImageVolume& image, NiftiType type);
 
+/// How a displacement field's vectors are stored in a NIfTI file.
+enum class NiftiDisplacementLayout {
+  /// intent NIFTI_INTENT_DISPVECT (1006), components in the file's RAS frame: the NIfTI standard's
+  /// displacement field, as ITK >= 5.4, 3D Slicer and nibabel read and write it
+  DispVectRas,
+  /// intent NIFTI_INTENT_VECTOR (1007), components LPS: ITK's layout before 5.4, the only one
+  /// tools built on older ITK (plastimatch 1.9, elastix 5.0, ANTs before 2.5) read as a field
+  VectorLps,
+};
+
 /// Writes a displacement field u on the voxels of `grid` (its values are ignored):
-/// `displacement_lps_m` holds 3 floats (LPS metres) per voxel, i fastest. Stored as in ITK >= 5.4
-/// and 3D Slicer: float32, dims (nx, ny, nz, 1, 3), intent NIFTI_INTENT_DISPVECT (1006),
-/// components in the file's RAS frame (x and y negated) and in mm, sform/qform as write_nifti.
-/// u maps a point x of the grid to x + u(x). Atomic like write_nifti.
+/// `displacement_lps_m` holds 3 floats (LPS metres) per voxel, i fastest. Stored as float32,
+/// dims (nx, ny, nz, 1, 3), components in mm in the given layout (the standard one by default),
+/// sform/qform as write_nifti. u maps a point x of the grid to x + u(x). Atomic like write_nifti.
 void write_nifti_displacement(const std::string& path, const ImageVolume& grid,
-                              const std::vector<float>& displacement_lps_m);
+                              const std::vector<float>& displacement_lps_m,
+                              NiftiDisplacementLayout layout = NiftiDisplacementLayout::DispVectRas);
 
 /// The inverse of write_nifti_displacement: returns the grid (values empty, affine as
 /// read_nifti) and fills `displacement_lps_m` (3 per voxel, LPS metres). Accepts dims

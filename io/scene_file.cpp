@@ -630,16 +630,23 @@ ReproducibilitySpec read_reproducibility(const Section& s, const std::vector<Anc
   return r;
 }
 
+const NameTable<bool> kDvfNiftiLayouts = {{"standard", false, {}}, {"legacy", true, {}}};  // value: legacy
+
 OutputSpec read_output(const Section& s, const ModelSpec& model) {
-  s.check_keys({"frames_every", "dvf", "warped_ct", "warped_ct_dicom", "fields", "surfaces"});
+  s.check_keys({"frames_every", "dvf", "dvf_nifti", "dvf_dicom", "warped_ct", "warped_ct_dicom", "fields", "surfaces"});
   OutputSpec out;
   out.frames_every = s.integer<int>("frames_every", 0).value_or(out.frames_every);
-  for (const char* key : {"dvf", "warped_ct", "warped_ct_dicom", "fields"}) {
+  for (const char* key : {"dvf", "dvf_nifti", "dvf_dicom", "warped_ct", "warped_ct_dicom", "fields"}) {
     if (s.find(key) && !model.from_image()) s.fail(key, "needs a CT image model (model.image)");
   }
   out.dvf = s.boolean("dvf").value_or(out.dvf);
+  (void)s.named("dvf_nifti", kDvfNiftiLayouts);  // checked here, read by dvf_file_options
+  if (s.find("dvf_nifti") && !out.dvf) s.fail("dvf_nifti", "sets the layout of the DVF files, but dvf = false writes none");
   out.warped_ct = s.boolean("warped_ct").value_or(out.warped_ct);
   out.warped_ct_dicom = s.boolean("warped_ct_dicom").value_or(out.warped_ct_dicom);
+  if (s.boolean("dvf_dicom").value_or(false) && !out.warped_ct_dicom)
+    s.fail("dvf_dicom", "the DICOM registration references the warped CT series, but warped_ct_dicom = false",
+           "set warped_ct_dicom = true, or leave dvf_dicom out");
   out.fields = s.boolean("fields").value_or(out.fields);
   out.surfaces = s.boolean("surfaces").value_or(out.surfaces);
   return out;
@@ -732,8 +739,22 @@ const std::vector<std::string>& scene_path_keys() {
   return keys;
 }
 
-Scene parse_scene_file(const std::string& path) {
-  Scene scene = parse_scene_text(read_text_file(path), path);
+DvfFileOptions dvf_file_options(const Scene& scene) {
+  DvfFileOptions options;
+  const toml::table root = parse_toml_text(scene.source_text, scene.source_path);
+  const toml::table* output = root["output"].as_table();
+  if (!output) return options;
+  options.legacy_nifti = output->get_as<std::string>("dvf_nifti") && **output->get_as<std::string>("dvf_nifti") == "legacy";
+  options.dicom = (*output)["dvf_dicom"].value_or(scene.output.warped_ct_dicom) && scene.output.warped_ct_dicom;
+  return options;
+}
+
+Scene parse_scene_file(const std::string& path) { return parse_scene_file(path, {}); }
+
+Scene parse_scene_file(const std::string& path, const std::vector<SceneOverride>& overrides) {
+  std::string text = read_text_file(path);
+  if (!overrides.empty()) text = apply_scene_overrides(text, path, overrides);
+  Scene scene = parse_scene_text(text, path);
   scene.source_path = path;
   resolve_paths(scene.model, path);
   return scene;

@@ -200,6 +200,30 @@ std::vector<std::string> split_scene_key(const std::string& key) {
   return parts;
 }
 
+SceneOverride parse_scene_setting(const std::string& argument) {
+  const std::string where = "--set " + argument;
+  const std::string example = "e.g. --set materials.adipose.E=3000 or --set gravity.posture=supine";
+  const std::size_t eq = argument.find('=');
+  if (eq == std::string::npos) throw Error("expected KEY=VALUE", where, example);
+  SceneOverride setting;
+  setting.key = argument.substr(0, eq);
+  const auto space = [](unsigned char c) { return std::isspace(c) != 0; };
+  setting.key.erase(setting.key.begin(), std::find_if_not(setting.key.begin(), setting.key.end(), space));
+  while (!setting.key.empty() && space(setting.key.back())) setting.key.pop_back();
+  if (!setting.key.empty() && setting.key[0] == '+') {
+    setting.key.erase(0, 1);
+    setting.add = true;
+  }
+  if (setting.key.empty()) throw Error("the key is empty", where, example);
+  try {
+    (void)split_scene_key(setting.key);
+    setting.value = toml_value_text(argument.substr(eq + 1));
+  } catch (const Error& e) {
+    throw Error(e.problem(), where, e.hint());
+  }
+  return setting;
+}
+
 std::string toml_string_text(const std::string& value) {
   std::ostringstream out;
   out << toml::value<std::string>(value);

@@ -19,6 +19,11 @@ struct SceneOverride {
   bool add = false;
 };
 
+/// One `KEY=VALUE` setting from a command line (`simulate --set`): KEY a dotted key as above,
+/// `+KEY` to add a key the scene lacks, VALUE one value as toml_value_text reads it (3000,
+/// prone, [0, 0, -9.81]). Throws vb::Error naming the argument when it is malformed.
+SceneOverride parse_scene_setting(const std::string& argument);
+
 /// The parts of a dotted key; throws vb::Error for empty parts or an unclosed quote.
 std::vector<std::string> split_scene_key(const std::string& key);
 

@@ -66,11 +66,7 @@ std::string string_array(const std::string& name, const std::vector<std::string>
 
 }  // namespace
 
-std::string field_data(const std::vector<std::string>& tissue_names) {
-  std::string out = "<FieldData>\n" + string_array("SPACE", {"LPS"});
-  if (!tissue_names.empty()) out += string_array("tissue_names", tissue_names);
-  return out + "</FieldData>\n";
-}
+std::string field_data() { return "<FieldData>\n" + string_array("SPACE", {"LPS"}) + "</FieldData>\n"; }
 
 std::string escape_attribute(const std::string& text) {
   std::string out;

@@ -20,9 +20,8 @@ const char* type_name();
 template <class T>
 std::string data_array(const std::string& name, int components, const std::vector<T>& values);
 
-/// `<FieldData>` with SPACE = "LPS" (3D Slicer reads it: coordinates are DICOM LPS) and, when
-/// given, a string array `tissue_names`.
-std::string field_data(const std::vector<std::string>& tissue_names = {});
+/// `<FieldData>` with SPACE = "LPS" (3D Slicer reads it: coordinates are DICOM LPS).
+std::string field_data();
 
 /// Escapes &, <, >, " for an attribute value.
 std::string escape_attribute(const std::string& text);

@@ -14,6 +14,7 @@ packages=(
   python3 python3-matplotlib python3-numpy python3-h5py python3-vtk9
   libopenmpi-dev openmpi-bin
   python3-dolfinx
+  plastimatch elastix dicom3tools python3-meshio
 )
 
 missing=()

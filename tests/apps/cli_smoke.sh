@@ -107,6 +107,11 @@ assert np.array_equal(s.pixel_array.T * float(s.RescaleSlope) + float(s.RescaleI
 PY
 then pass "phantom rerun into its folder replaces the CT, labels and DICOM series"
 else fail "phantom rerun"; fi
+# The phantom's DICOM series is deterministic: the same phantom gives byte-identical files.
+if "$bin" phantom --out "$work/phantom_again" --spacing 6 --seed 2 >/dev/null 2>&1 \
+   && diff -r "$ph/dicom" "$work/phantom_again/dicom" >/dev/null
+then pass "phantom DICOM series is the same, UIDs included, on every run"
+else fail "phantom DICOM determinism"; fi
 cp "$ph/ct.nii.gz" "$work/ph_seed2.nii.gz" && touch "$ph/dicom/notes.txt"
 if ! "$bin" phantom --out "$ph" --spacing 6 --seed 3 >/dev/null 2>"$work/ph_foreign.err" \
    && grep -q "holds 'notes.txt'" "$work/ph_foreign.err" && cmp -s "$ph/ct.nii.gz" "$work/ph_seed2.nii.gz"
@@ -255,6 +260,19 @@ assert len(s["warnings"]) == 2, s["warnings"]
 PY
 then pass "hull masses in summary.json; one-voxel sheet: $(head -1 "$work/sheet.err")"
 else fail "hull masses and one-voxel sheet warning"; cat "$work/sheet.err"; fi
+# simulate --set: one value by dotted key, checked as sweep --vary checks it
+scene >"$work/set.toml"
+if "$bin" simulate "$work/set.toml" --out "$work/set" --quiet --set materials.soft.E=6000 --set +solver.integrator=relaxation \
+     >/dev/null 2>&1 && h5dump -a /scene_toml "$work/set/result.h5" | grep -q 'E = 6000' \
+   && h5dump -a /scene_toml "$work/set/result.h5" | grep -q 'integrator = .relaxation'
+then pass "--set changes the scene the run uses (result.h5 keeps the edited text)"
+else fail "--set"; fi
+for bad in "materials.soft.Ee=1|did you mean 'E'" "materials.soft.E=-1|materials.soft.E" "materials.soft.E|--set materials.soft.E: expected KEY=VALUE"; do
+  if ! "$bin" simulate "$work/set.toml" --out "$work/set_bad" --quiet --set "${bad%%|*}" >/dev/null 2>"$work/set_bad.err" \
+     && [[ $(wc -l <"$work/set_bad.err") -eq 1 ]] && grep -q "^voxbreast: error:.*${bad#*|}" "$work/set_bad.err" && [[ ! -e "$work/set_bad" ]]
+  then pass "--set ${bad%%|*}: $(cat "$work/set_bad.err")"
+  else fail "--set ${bad%%|*}"; cat "$work/set_bad.err"; fi
+done
 
 # A corrupt CT: the phantom scene with a truncated ct.nii.gz
 mkdir -p "$work/corrupt" && cp "$root/data-samples/phantom/labels.nii.gz" "$root/data-samples/phantom/scene.toml" "$work/corrupt/"

@@ -1,13 +1,16 @@
 #!/usr/bin/python3
-"""Checks VoxBreast's mesh files with VTK's own readers (Debian python3-vtk9).
+"""Checks VoxBreast's mesh files with VTK's own readers (Debian python3-vtk9) and the lattice
+.vtu also with meshio (Debian python3-meshio), the Python mesh stack's reader.
 
 Usage: check_meshes_vtk.py TEST_SURFACE_BINARY
 Runs the binary's MeshFilesForVtk test, which writes .vtp/.vtu/.ply/.stl files and expected.json
 into a temporary folder, then reads each file with vtkXMLPolyDataReader,
 vtkXMLUnstructuredGridReader, vtkPLYReader and vtkSTLReader and checks point and cell counts,
-arrays, the SPACE=LPS field, closedness, and volumes (mesh volume by vtkMassProperties,
-hexahedron volumes by vtkCellSizeFilter, which also checks VTK's corner order).
-Exit 0 when all checks pass, 1 on a failure, 77 (ctest SKIP_RETURN_CODE) without VTK.
+arrays, the SPACE=LPS field of the .vtp files, the tissue ids of the .vtu, closedness, and volumes
+(mesh volume by vtkMassProperties, hexahedron volumes by vtkCellSizeFilter, which also checks
+VTK's corner order); then reads each .vtu with meshio.read and checks points, hexahedra, point data
+and the tissue ids in its field data.
+Exit 0 when all checks pass, 1 on a failure, 77 (ctest SKIP_RETURN_CODE) without VTK or meshio.
 """
 import json
 import os
@@ -23,8 +26,10 @@ try:
     from vtkmodules.vtkIOGeometry import vtkSTLReader
     from vtkmodules.vtkIOPLY import vtkPLYReader
     from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLUnstructuredGridReader
+    import meshio
+    import numpy as np
 except ImportError as error:
-    print(f"SKIP: VTK's Python modules are missing ({error}); install python3-vtk9 (scripts/setup.sh)")
+    print(f"SKIP: {error}; install python3-vtk9 and python3-meshio (scripts/setup.sh)")
     sys.exit(77)
 
 failures = []
@@ -96,7 +101,10 @@ def check_grid(name, path, exp):
     check(grid.GetNumberOfCells() == exp["hexahedra"], f"{name}: {grid.GetNumberOfCells()} cells, expected {exp['hexahedra']}")
     types = {grid.GetCellType(i) for i in range(grid.GetNumberOfCells())}
     check(types == {VTK_HEXAHEDRON}, f"{name}: cell types {sorted(types)}")
-    check(field_string(grid, "SPACE") == "LPS", f"{name}: field SPACE")
+    for tissue_id, tissue in enumerate(exp["tissues"]):
+        a = grid.GetFieldData().GetArray(tissue)
+        check(a is not None and a.GetNumberOfTuples() == 1 and a.GetValue(0) == tissue_id,
+              f"{name}: field data {tissue!r} = tissue id {tissue_id}")
     for array in ("displacement_mm", "tissue", "equivalent_strain"):
         a = grid.GetPointData().GetArray(array)
         check(a is not None and a.GetNumberOfTuples() == exp["elements"], f"{name}: point array {array}")
@@ -109,6 +117,26 @@ def check_grid(name, path, exp):
     total = sum(volumes.GetValue(i) for i in range(volumes.GetNumberOfTuples()))
     check(smallest > 0, f"{name}: every hexahedron has positive volume (VTK corner order), smallest {smallest:.4g} mm³")
     check(close(total, exp["volume_mm3"]), f"{name}: hexahedra volume {total:.6g} mm³, expected {exp['volume_mm3']:.6g}")
+
+
+def check_grid_meshio(name, path, exp):
+    try:
+        mesh = meshio.read(path)
+    except Exception as error:  # meshio raises its own ReadError and others
+        check(False, f"{name}: meshio.read fails: {error}")
+        return
+    check(len(mesh.points) == exp["elements"], f"{name} (meshio): {len(mesh.points)} points")
+    hexahedra = sum(len(block.data) for block in mesh.cells if block.type == "hexahedron")
+    check(hexahedra == exp["hexahedra"] and all(block.type == "hexahedron" for block in mesh.cells),
+          f"{name} (meshio): {hexahedra} hexahedra, expected {exp['hexahedra']}")
+    for array in ("displacement_mm", "tissue", "equivalent_strain"):
+        check(array in mesh.point_data and len(mesh.point_data[array]) == exp["elements"],
+              f"{name} (meshio): point array {array}")
+    names = {tissue: int(np.asarray(ids).ravel()[0]) for tissue, ids in mesh.field_data.items()}
+    check(names == {tissue: i for i, tissue in enumerate(exp["tissues"])}, f"{name} (meshio): tissue ids {names}")
+    if "tissue" in mesh.point_data:
+        used = set(np.unique(mesh.point_data["tissue"]).tolist())
+        check(used <= set(names.values()), f"{name} (meshio): every point's tissue has a name")
 
 
 def main():
@@ -129,6 +157,7 @@ def main():
             check_polydata(name + "_rest.vtp", base + "_rest.vtp", exp, deformed=False)
             check_polydata(name + "_deformed.vtp", base + "_deformed.vtp", exp, deformed=True)
             check_grid(name + ".vtu", base + ".vtu", exp)
+            check_grid_meshio(name + ".vtu", base + ".vtu", exp)
             ply = read(vtkPLYReader, base + ".ply")
             check(ply.GetNumberOfPoints() == exp["points"] and ply.GetNumberOfCells() == exp["triangles"],
                   f"{name}.ply: {ply.GetNumberOfPoints()} points, {ply.GetNumberOfCells()} triangles")

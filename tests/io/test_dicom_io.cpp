@@ -561,6 +561,75 @@ TEST(DicomWrite, DefaultsWithoutSourceTags) {
   EXPECT_FALSE(back.dicom_tags.at("0020,0052").empty());
 }
 
+TEST(DicomWrite, PatientPositionFollowsGravity) {
+  EXPECT_EQ(dicom_patient_position({0, 9.8, 0}), "HFS");   // gravity towards the back: supine
+  EXPECT_EQ(dicom_patient_position({0, -9.8, 0}), "HFP");  // prone
+  EXPECT_EQ(dicom_patient_position({9.8, 0, 0}), "HFDL");  // towards the left: on the left side
+  EXPECT_EQ(dicom_patient_position({-9.8, 0, 0}), "HFDR");
+  EXPECT_EQ(dicom_patient_position({0, 9.0, 3.0}), "HFS");  // a tilted supine is still supine
+  EXPECT_EQ(dicom_patient_position({0, 0, -9.8}), "");      // upright: PatientPosition cannot say
+  EXPECT_EQ(dicom_patient_position({0, 0, 0}), "");
+}
+
+/// The same volume written twice deterministically gives the same bytes; another voxel value,
+/// other UIDs. Without `deterministic`, every write has its own UIDs and dates.
+TEST(DicomWrite, DeterministicSeriesAreByteIdentical) {
+  TempDir tmp;
+  ImageVolume v = oblique_volume(3);
+  v.dicom_tags.clear();
+  DicomSeriesOptions options;
+  options.series_description = "phantom";
+  options.patient_position = "HFS";
+  options.deterministic = true;
+  const WrittenDicomSeries a = write_dicom_series((tmp / "a").string(), v, options);
+  const WrittenDicomSeries b = write_dicom_series((tmp / "b").string(), v, options);
+  EXPECT_EQ(a.series_uid, b.series_uid);
+  EXPECT_EQ(a.instance_uids, b.instance_uids);
+  EXPECT_EQ(a.series_uid.rfind("2.25.", 0), 0u) << a.series_uid;
+  EXPECT_EQ(std::set<std::string>(a.instance_uids.begin(), a.instance_uids.end()).size(), 3u);
+  for (const fs::path& file : files_in(tmp / "a")) {
+    std::ifstream x(file, std::ios::binary), y(tmp / "b" / file.filename(), std::ios::binary);
+    const std::string bx((std::istreambuf_iterator<char>(x)), {}), by((std::istreambuf_iterator<char>(y)), {});
+    EXPECT_TRUE(bx == by) << file.filename();
+  }
+  v.values[4] += 1;
+  const WrittenDicomSeries c = write_dicom_series((tmp / "c").string(), v, options);
+  EXPECT_NE(c.series_uid, a.series_uid);
+  EXPECT_NE(c.study_uid, a.study_uid);
+  options.deterministic = false;
+  EXPECT_NE(write_dicom_series((tmp / "d").string(), v, options).series_uid,
+            write_dicom_series((tmp / "e").string(), v, options).series_uid);
+  if (!have_tool("dcmdump")) GTEST_SKIP() << "dcmdump (DCMTK) is not installed";
+  const std::string fixed = run_command("dcmdump " + quoted(tmp / "a" / "CT00001.dcm")).output;
+  EXPECT_NE(fixed.find("[HFS]"), std::string::npos);
+  EXPECT_EQ(fixed.find("SeriesDate"), std::string::npos);  // no date in a deterministic series
+  EXPECT_NE(run_command("dcmdump " + quoted(tmp / "d" / "CT00001.dcm")).output.find("SeriesDate"), std::string::npos);
+}
+
+/// A series derived from a read one names, per slice, the read slices it samples.
+TEST_F(DicomSeriesTest, SourceImageSequenceNamesTheInputSlices) {
+  const ImageVolume source = read_dicom_series(series_.string());
+  DicomSeriesOptions options;
+  options.series_description = "derived";
+  for (int k = 0; k < source.dims[2]; ++k) options.source_slices.push_back({k, std::min(k + 1, source.dims[2] - 1)});
+  const fs::path derived = tmp_ / "derived";
+  write_dicom_series(derived.string(), source, options);
+  if (!have_tool("dcmdump")) GTEST_SKIP() << "dcmdump (DCMTK) is not installed";
+  const auto source_uid = [&](int k) {
+    return run_command("dcmdump +P SOPInstanceUID " + quoted(series_ / ("CT0000" + std::to_string(k + 1) + ".dcm")))
+        .output;
+  };
+  const std::string second = run_command("dcmdump +P ReferencedSOPInstanceUID " + quoted(derived / "CT00002.dcm")).output;
+  const auto uid_in = [](const std::string& line) { return line.substr(line.find('[') + 1, line.find(']') - line.find('[') - 1); };
+  EXPECT_NE(second.find(uid_in(source_uid(1))), std::string::npos) << second;
+  EXPECT_NE(second.find(uid_in(source_uid(2))), std::string::npos) << second;
+  EXPECT_EQ(second.find(uid_in(source_uid(0))), std::string::npos) << second;
+  // A volume not read from DICOM has no slices to name.
+  ImageVolume plain = volume_;
+  plain.dicom_tags.clear();
+  EXPECT_THROW(write_dicom_series((tmp_ / "plain").string(), plain, options), Error);
+}
+
 /// Values beyond int16 with intercept −1024 get a fitted slope: still within half a step.
 TEST(DicomWrite, WideRangeGetsAFittedSlope) {
   TempDir tmp;

@@ -255,6 +255,7 @@ TEST(MeshFilesForVtk, WriteMeshesAndExpectedCounts) {
         {"volume_mm3", double(mesh.complete_cell_count) * h_mm * h_mm * h_mm},
         {"max_displacement_mm", 1000 * *std::max_element(u.begin(), u.end())},
         {"point_arrays", {"displacement_mm", "Normals", "element", "equivalent_strain"}},
+        {"tissues", lat.tissue_names},
     };
   }
   std::ofstream(dir / "expected.json") << expected.dump(2);

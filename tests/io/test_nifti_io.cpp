@@ -351,6 +351,34 @@ TEST_F(NiftiIo, DisplacementRoundTrip) {
   }
 }
 
+TEST_F(NiftiIo, LegacyDisplacementLayoutIsIntent1007WithLpsComponents) {
+  const ImageVolume grid = oblique_grid();
+  const std::vector<float> u = sample_displacement(grid);
+  write_nifti_displacement(path("ras.nii"), grid, u);
+  write_nifti_displacement(path("lps.nii"), grid, u, NiftiDisplacementLayout::VectorLps);
+  const auto header_and_data = [&](const std::string& name) {
+    nifti_image* nim = nifti_image_read(path(name).c_str(), 1);
+    EXPECT_NE(nim, nullptr);
+    const int intent = nim->intent_code;
+    std::vector<float> data(static_cast<const float*>(nim->data), static_cast<const float*>(nim->data) + nim->nvox);
+    nifti_image_free(nim);
+    return std::make_pair(intent, data);
+  };
+  const auto [ras_intent, ras] = header_and_data("ras.nii");
+  const auto [lps_intent, lps] = header_and_data("lps.nii");
+  EXPECT_EQ(ras_intent, NIFTI_INTENT_DISPVECT);
+  EXPECT_EQ(lps_intent, NIFTI_INTENT_VECTOR);
+  const std::size_t n = grid.voxel_count();
+  for (std::size_t v = 0; v < n; ++v)
+    for (std::size_t c = 0; c < 3; ++c) {
+      ASSERT_FLOAT_EQ(lps[c * n + v], 1e3f * u[3 * v + c]) << "voxel " << v;           // LPS mm
+      ASSERT_FLOAT_EQ(ras[c * n + v], (c < 2 ? -1e3f : 1e3f) * u[3 * v + c]) << "voxel " << v;  // RAS mm
+    }
+  std::vector<float> back;  // our reader takes both layouts to the same field
+  read_nifti_displacement(path("lps.nii"), back);
+  for (std::size_t f = 0; f < u.size(); ++f) ASSERT_NEAR(back[f], u[f], 1e-6 * std::abs(u[f]) + 1e-12);
+}
+
 // ---- reading files from elsewhere --------------------------------------------------------------
 
 TEST_F(NiftiIo, ScaleSlopeAndInterceptAreApplied) {

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -181,6 +182,46 @@ TEST(SceneValues, WordsBecomeStringsAndTomlStaysAsWritten) {
   EXPECT_THROW(toml_value_text("  "), Error);
   EXPECT_EQ(toml_value_plain("'prone'"), "prone");
   EXPECT_EQ(toml_value_plain("[1, 2]"), "[1, 2]");
+}
+
+TEST(SceneSettings, ParsesOneKeyAndOneValue) {
+  const SceneOverride e = parse_scene_setting("materials.soft.E=4500");
+  EXPECT_EQ(e.key, "materials.soft.E");
+  EXPECT_EQ(e.value, "4500");
+  EXPECT_FALSE(e.add);
+  const SceneOverride posture = parse_scene_setting(" +gravity.posture = prone");
+  EXPECT_EQ(posture.key, "gravity.posture");
+  EXPECT_EQ(posture.value, "'prone'");
+  EXPECT_TRUE(posture.add);
+  EXPECT_EQ(parse_scene_setting("gravity.vector=[0, -9.81, 0]").value, "[0, -9.81, 0]");
+  EXPECT_EQ(parse_scene_setting("track.1.name=a,b").value, "'a,b'");  // one value: commas do not split
+  for (const char* bad : {"materials.soft.E", "=3", "+=3", "a..b=1", "a.b=", "a.b=nan", "a.b={x = 1}"}) {
+    try {
+      parse_scene_setting(bad);
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const Error& error) {
+      EXPECT_NE(std::string(error.what()).find(std::string("--set ") + bad), std::string::npos) << error.what();
+    }
+  }
+}
+
+TEST(SceneSettings, AFileReadWithSettingsHasThemAndPassesTheStrictChecks) {
+  const std::string path = ::testing::TempDir() + "/settings_scene.toml";
+  {
+    FILE* f = std::fopen(path.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs(kScene.c_str(), f);
+    std::fclose(f);
+  }
+  const Scene s = parse_scene_file(path, {parse_scene_setting("materials.soft.E=4500"),
+                                          parse_scene_setting("+solver.dt=1e-4")});
+  EXPECT_DOUBLE_EQ(s.materials.at("soft").youngs_modulus_pa, 4500);
+  EXPECT_DOUBLE_EQ(s.solver.dt_s.value_or(0), 1e-4);
+  EXPECT_NE(s.source_text.find("E = 4500"), std::string::npos);  // result.h5 keeps the scene as run
+  EXPECT_EQ(s.source_path, path);
+  EXPECT_THROW(parse_scene_file(path, {parse_scene_setting("materials.soft.E=-1")}), Error);  // strict range check
+  EXPECT_THROW(parse_scene_file(path, {parse_scene_setting("materials.soft.Ee=1")}), Error);  // no such key
+  std::remove(path.c_str());
 }
 
 TEST(SceneValues, ReadsStringValues) {
