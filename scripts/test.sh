@@ -9,3 +9,5 @@ bash "$root/scripts/build.sh"
 export VOXBREAST_DEVICE=${VOXBREAST_DEVICE:-cpu}
 cd "$build"
 ctest --output-on-failure --parallel "$(nproc)" --timeout 1200
+# The io and engine unit tests again under ASan and UBSan, in build-sanitize/.
+bash "$root/scripts/sanitize.sh"

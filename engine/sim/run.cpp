@@ -166,8 +166,8 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
   const std::int64_t check_every = std::max(1, scene.solver.check_every);
   const std::int64_t frames_every = scene.output.frames_every;
   std::int64_t max_steps = scene.stop.max_steps;
-  if (std::isfinite(scene.stop.max_time_s))
-    max_steps = std::min<std::int64_t>(max_steps, std::int64_t(std::ceil(scene.stop.max_time_s / sim.dt_s() - 1e-9)));
+  const double time_steps = std::ceil(scene.stop.max_time_s / sim.dt_s() - 1e-9);  // compared before the cast
+  if (time_steps < double(max_steps)) max_steps = std::max<std::int64_t>(0, std::int64_t(time_steps));
 
   RunOutput out;
   RunSummary& s = out.summary;
