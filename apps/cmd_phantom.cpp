@@ -11,6 +11,7 @@
 #include "io/atomic_file.hpp"
 #include "io/dicom_io.hpp"
 #include "io/nifti_io.hpp"
+#include "io/run_folder.hpp"
 
 namespace vb::app {
 namespace {
@@ -46,21 +47,23 @@ std::string phantom_scene(const Phantom& p, const PhantomSpec& spec) {
 }
 
 int run_phantom(const PhantomOptions& o) {
-  const OutputDir output_dir(o.out);
+  RunFolder folder(o.out, "phantom", {"ct.nii.gz", "labels.nii.gz", "dicom", "scene.toml"});
   check_dicom_series_replaceable(o.out + "/dicom");  // refuse before any file is replaced
   PhantomSpec spec;
   spec.seed = o.seed;
   spec.spacing_m = o.spacing_mm * 1e-3;
   for (const std::string& t : o.tumours) spec.tumours.push_back(parse_tumour_option(t));
   const Phantom p = make_breast_phantom(spec);
-  write_nifti(o.out + "/ct.nii.gz", p.ct, NiftiType::Int16);
-  write_nifti(o.out + "/labels.nii.gz", p.labels, NiftiType::UInt8);
+  const std::string& dir = folder.staging();
+  write_nifti(dir + "/ct.nii.gz", p.ct, NiftiType::Int16);
+  write_nifti(dir + "/labels.nii.gz", p.labels, NiftiType::UInt8);
   DicomSeriesOptions series;
   series.series_description = "VoxBreast synthetic breast phantom";
   series.patient_position = dicom_patient_position(gravity_for_posture("supine"));  // the phantom lies supine
   series.deterministic = true;  // the same phantom always gives the same files, UIDs included
-  replace_dicom_series(o.out + "/dicom", p.ct, series);
-  write_text_atomically(o.out + "/scene.toml", phantom_scene(p, spec));
+  replace_dicom_series(dir + "/dicom", p.ct, series);
+  write_text_atomically(dir + "/scene.toml", phantom_scene(p, spec));
+  folder.commit();
   std::printf("phantom %d × %d × %d voxels of %.1f mm, seed %llu\nwrote %s/ct.nii.gz, labels.nii.gz, dicom/, scene.toml\n",
               p.ct.dims[0], p.ct.dims[1], p.ct.dims[2], o.spacing_mm, (unsigned long long)o.seed, o.out.c_str());
   return 0;

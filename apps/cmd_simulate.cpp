@@ -9,6 +9,7 @@
 #include "io/atomic_file.hpp"
 #include "io/scene_file.hpp"
 #include "io/scene_overrides.hpp"
+#include "io/run_folder.hpp"
 
 namespace vb::app {
 namespace {
@@ -27,7 +28,8 @@ int run_simulate(const SimulateOptions& o) {
     scene.solver.precision = o.precision == "double" ? Precision::Double : Precision::Float;
   if (!o.series.empty()) scene.model.series_uid = o.series;
   scene.model.allow_gaps = scene.model.allow_gaps || o.allow_gaps;
-  const OutputDir output_dir(o.out);  // fail before computing, not after
+  // Fails before computing, not after; the run writes into its staging folder until commit().
+  RunFolder folder(o.out, "simulate", {"summary.json", "metrics.csv", "result.h5"});
   const ClContext cl(select_device(o.device));
   Progress bar(!o.quiet);
   SimulationOptions options;
@@ -58,7 +60,9 @@ int run_simulate(const SimulateOptions& o) {
                  r.rpy_deg.y(), r.rpy_deg.z(), 1e3 * r.tumour_centroid_m.x(), 1e3 * r.tumour_centroid_m.y(),
                  1e3 * r.tumour_centroid_m.z(), r.converged ? "" : ", stopped before equilibrium");
   };
-  const SimulationReport report = simulate_scene(scene, cl, o.out, options);
+  options.final_dir = o.out;
+  const SimulationReport report = simulate_scene(scene, cl, folder.staging(), options);
+  folder.commit();
   bar.finish();
 
   const RunSummary& s = report.summary;

@@ -50,7 +50,7 @@ SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const s
   std::unique_lock io(file_io_mutex());
   const PreparedModel model = prepare_model(scene, &cl.info);
   if (options.full_outputs && model.ct && scene.output.warped_ct_dicom)  // refuse before the run, not after it
-    check_dicom_series_replaceable(out_dir + "/warped_ct_dicom");
+    check_dicom_series_replaceable((options.final_dir.empty() ? out_dir : options.final_dir) + "/warped_ct_dicom");
   io.unlock();
   check_positioning(scene, model.lattice);  // a misnamed tumour tissue fails now, not after the run
   Simulator sim(scene, model.lattice, model.elements, cl);

@@ -17,6 +17,9 @@ struct SimulationOptions {
   /// true: summary.json, result.h5 and the image outputs and meshes the scene asks for;
   /// false: summary.json only (sweeps, where the numbers are what counts).
   bool full_outputs = true;
+  /// The folder the outputs end up in when `out_dir` is a staging folder (RunFolder): an earlier
+  /// series there must be VoxBreast's own before the run starts. Empty: `out_dir` itself.
+  std::string final_dir;
   /// Called once the model is built and the simulator is ready, before the run.
   std::function<void(const PreparedModel&, const Simulator&)> on_start;
   std::function<void(const RunProgress&)> on_progress;

@@ -81,14 +81,21 @@ void warn_lumped_mass(const Scene& scene, const Lattice& lattice, const ElementA
 
 PreparedModel prepare_model(const Scene& scene, const DeviceInfo* device) {
   PreparedModel m;
+  MemoryBudget budget;  // checked before the voxel grid is allocated
+  budget.host_bytes = available_host_memory_bytes();
+  if (device) {
+    budget.device_bytes = device->global_memory_bytes;
+    budget.device_name = device->name;
+  }
   if (scene.model.from_image()) {
     m.ct = load_ct(scene.model, m.warnings);
     std::optional<ImageVolume> labels;
     if (!scene.model.labels_path.empty()) labels = read_nifti(scene.model.labels_path);
     const TissueMap map = classify_image(scene.model, *m.ct, labels ? &*labels : nullptr);
-    m.lattice = build_lattice(lattice_volume_from_image(scene.model, *m.ct, map), scene.model.downsample);
+    m.lattice = build_lattice(lattice_volume_from_image(scene.model, *m.ct, map, scene.solver.precision, budget),
+                              scene.model.downsample);
   } else {
-    m.lattice = build_lattice(voxelise_shapes(scene), scene.model.downsample);
+    m.lattice = build_lattice(voxelise_shapes(scene, budget), scene.model.downsample);
   }
   if (device) check_lattice_fits_device(scene, m.lattice, *device);
   m.elements = make_element_arrays(scene, m.lattice);

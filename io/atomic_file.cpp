@@ -1,9 +1,11 @@
 #include "io/atomic_file.hpp"
+#include "io/system_reason.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -90,17 +92,22 @@ void OutputDir::remove_empty_created() const noexcept {
     if (!fs::is_directory(p, ec) || !fs::is_empty(p, ec) || !fs::remove(p, ec)) break;
 }
 
+std::string system_reason(int errnum) {
+  std::string reason = std::strerror(errnum);
+  if (!reason.empty()) reason[0] = char(std::tolower(static_cast<unsigned char>(reason[0])));
+  return reason;
+}
+
 void write_text_atomically(const std::string& path, const std::string& text) {
   AtomicOutput out(path);
   std::FILE* f = std::fopen(out.temp_path().c_str(), "wb");
-  if (!f) throw Error(std::string("cannot create file: ") + std::strerror(errno), path);
+  if (!f) throw Error("cannot create file: " + system_reason(errno), path);
   const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
   const int write_errno = errno;
   // fclose flushes the buffer, so its failure (e.g. disk full) is a write failure too.
   const bool closed = std::fclose(f) == 0;
   if (!written || !closed)
-    throw Error(std::string("cannot write file: ") + std::strerror(written ? errno : write_errno),
-                path);
+    throw Error("cannot write file: " + system_reason(written ? errno : write_errno), path);
   out.commit();
 }
 

@@ -41,6 +41,9 @@ class InflatingReader {
     return done;
   }
   std::uint64_t position() const { return position_; }
+  /// Whether the deflate stream ended with its final block and inflated without an error: a
+  /// stream cut off or corrupted between two attributes reads like a shorter dataset otherwise.
+  bool complete() const { return ok_ && stream_end_; }
 
  private:
   bool refill() {
@@ -56,7 +59,7 @@ class InflatingReader {
       }
       if (ended_) break;
       const int status = inflate(&z_, Z_NO_FLUSH);
-      if (status == Z_STREAM_END) ended_ = true;
+      if (status == Z_STREAM_END) ended_ = stream_end_ = true;
       else if (status != Z_OK) ok_ = false;
     }
     end_ = output_.size() - z_.avail_out;
@@ -65,7 +68,7 @@ class InflatingReader {
 
   std::ifstream& in_;
   z_stream z_{};
-  bool ok_ = false, ended_ = false;
+  bool ok_ = false, ended_ = false, stream_end_ = false;
   std::array<unsigned char, 16384> input_{}, output_{};
   std::size_t next_ = 0, end_ = 0;
   std::uint64_t position_ = 0;
@@ -257,7 +260,7 @@ void check_deflated_dataset(const std::string& path) {
   in.seekg(std::streamoff(meta->dataset_offset));
   const bool positioned = bool(in);
   InflatingReader inflated(in);
-  require(positioned && DeflatedDatasetWalk(inflated).dataset(),
+  require(positioned && DeflatedDatasetWalk(inflated).dataset() && inflated.complete(),
           "cannot parse DICOM file: the deflated dataset is corrupt or truncated (an attribute is "
           "longer than the data that holds it)",
           path, kCorruptFileHint);

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -22,6 +23,7 @@
 
 #include "engine/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/system_reason.hpp"
 #include "io/dicom_attributes.hpp"
 #include "io/dicom_io.hpp"
 #include "voxbreast/config.hpp"
@@ -341,8 +343,11 @@ void write_slice(const std::string& path, const SeriesAttributes& series, const 
   put.words(DCM_PixelData,
             stored_pixels(&ct.values[ct.linear_index(0, 0, k)], slice_voxels, series.rescale));
 
+  errno = 0;
   const OFCondition status = file.saveFile(path.c_str(), EXS_LittleEndianExplicit);
-  require(status.good(), std::string("cannot write DICOM file: ") + status.text(), path);
+  const int error = errno;  // DCMTK's text does not say why the stream failed; errno does
+  require(status.good(),
+          std::string("cannot write DICOM file: ") + status.text() + (error ? ": " + system_reason(error) : ""), path);
 }
 
 /// A hidden sibling folder that disappears unless it is renamed into place.

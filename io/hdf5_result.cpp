@@ -3,6 +3,7 @@
 #include <hdf5.h>
 
 #include <array>
+#include <cctype>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -18,18 +19,33 @@ namespace {
 
 // ---- errors --------------------------------------------------------------------------------
 
-/// The most specific message on HDF5's error stack (often the OS reason); clears the stack.
+/// One line from HDF5's error stack: the operating system's reason when an entry carries one
+/// (HDF5 writes it as "error message = '...'", e.g. no space left on device), else the most
+/// specific entry. Clears the stack.
 std::string hdf5_reason() {
-  std::string reason;
+  struct Found {
+    std::string innermost, system;
+  } found;
   H5Ewalk2(
       H5E_DEFAULT, H5E_WALK_UPWARD,
       [](unsigned n, const H5E_error2_t* err, void* out) -> herr_t {
-        if (n == 0 && err->desc) *static_cast<std::string*>(out) = err->desc;
+        auto& f = *static_cast<Found*>(out);
+        if (!err->desc) return 0;
+        const std::string desc = err->desc;
+        if (n == 0) f.innermost = desc;
+        const std::string key = "error message = '";
+        const std::size_t at = desc.find(key);
+        if (at != std::string::npos && f.system.empty()) {
+          const std::size_t from = at + key.size(), to = desc.find('\'', from);
+          f.system = desc.substr(from, to == std::string::npos ? std::string::npos : to - from);
+          if (!f.system.empty()) f.system[0] = char(std::tolower(static_cast<unsigned char>(f.system[0])));
+        }
         return 0;
       },
-      &reason);
+      &found);
   H5Eclear2(H5E_DEFAULT);
-  return reason;
+  const std::string& reason = found.system.empty() ? found.innermost : found.system;
+  return reason.substr(0, reason.find('\n'));
 }
 
 [[noreturn]] void fail(const std::string& what) {
@@ -213,6 +229,18 @@ void write_attribute(const Object& object, const std::string& name,
   write_attribute_data(object, name, type, type, {values.size()}, texts.data());
 }
 
+/// Once, before HDF5's first use: no error dumps on stderr (errors become one-line vb::Errors), and
+/// no library shutdown at exit, which closes what a failed write left open again and crashed in
+/// it after a full disk (the temporary file is removed by then; the OS frees the rest).
+void prepare_hdf5() {
+  static const bool prepared = [] {
+    H5dont_atexit();
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    return true;
+  }();
+  (void)prepared;
+}
+
 // ---- the result file -----------------------------------------------------------------------
 
 /// Per-element voxel indices (n×3) and rest positions (n×3, m, world frame).
@@ -332,10 +360,13 @@ void write_contents(hid_t file, const Lattice& lattice, const Scene& scene,
 
 void write_result_h5(const std::string& path, const Lattice& lattice, const Scene& scene,
                      const FinalState& state, const Frames& frames, const RunSummary& summary) {
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // we report through vb::Error, not stderr
+  prepare_hdf5();
   AtomicOutput out(path);
   try {
-    FileHandle file(H5Fcreate(out.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+    // Closing the file closes whatever is still open in it, also after a failed write.
+    Handle<H5Pclose> access(H5Pcreate(H5P_FILE_ACCESS), "cannot create file");
+    check_status(H5Pset_fclose_degree(access, H5F_CLOSE_STRONG), "cannot create file");
+    FileHandle file(H5Fcreate(out.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access),
                     "cannot create file");
     write_contents(file, lattice, scene, state, frames, summary);  // closes every object it opens
     file.close("cannot finish writing file");

@@ -1,10 +1,12 @@
 #include "io/nifti_io.hpp"
 
 #include <nifti/nifti2_io.h>
+#include <zlib.h>
 
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -22,6 +24,7 @@
 
 #include "engine/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/system_reason.hpp"
 
 namespace vb {
 namespace {
@@ -209,6 +212,48 @@ bool file_holds(const std::string& file, std::int64_t offset, std::uint64_t data
   return *isize >= needed || gzip_stream_has(file, needed);
 }
 
+/// A gzip file is decompressed to its end once before it is used: nifti_clib reads only the bytes
+/// the header asks for and never reaches a member's trailer, where zlib checks the CRC-32 and the
+/// length (ISIZE). Corrupt data inside a stream would otherwise be read as voxels. Several
+/// members are checked one after the other; bytes after the last member are refused too.
+void require_intact_gzip(const std::string& file, const std::string& path) {
+  if (!nifti_is_gzfile(file.c_str())) return;
+  std::ifstream in(file, std::ios::binary);
+  require(bool(in), "cannot open file", path, "check its permissions");
+  char magic[2] = {0, 0};
+  in.read(magic, 2);
+  if (!in || magic[0] != '\x1f' || magic[1] != '\x8b') return;  // znzlib reads it as it is
+  in.seekg(0);
+  z_stream z{};
+  require(inflateInit2(&z, 16 + MAX_WBITS) == Z_OK, "zlib cannot start inflating", path);
+  std::vector<unsigned char> input(std::size_t(1) << 16), output(std::size_t(1) << 18);
+  int status = Z_OK;
+  bool member_ended = false;  // the stream ends cleanly only right after a member's trailer
+  while (true) {
+    if (z.avail_in == 0) {
+      in.read(reinterpret_cast<char*>(input.data()), std::streamsize(input.size()));
+      z.next_in = input.data();
+      z.avail_in = uInt(in.gcount());
+      if (z.avail_in == 0) break;
+    }
+    if (member_ended) {  // another member follows (RFC 1952 allows several)
+      inflateReset(&z);
+      member_ended = false;
+    }
+    z.next_out = output.data();
+    z.avail_out = uInt(output.size());
+    status = inflate(&z, Z_NO_FLUSH);
+    if (status == Z_STREAM_END) member_ended = true;
+    else if (status != Z_OK && status != Z_BUF_ERROR) break;
+  }
+  const std::string reason = z.msg ? z.msg : "";
+  inflateEnd(&z);
+  require(member_ended,
+          status == Z_DATA_ERROR ? "corrupt gzip stream (" + reason + ")"
+                                 : std::string("corrupt gzip stream: it ends before its trailer"),
+          path, kCorruptFileHint);
+}
+
 /// The voxels (`data_bytes` from byte `offset` of `file`) must be there before nifti_image_load
 /// allocates room for them.
 void require_voxel_bytes(const std::string& file, std::int64_t offset, std::uint64_t data_bytes,
@@ -352,6 +397,7 @@ OpenedNifti open_header(const std::string& path) {
   const std::uint64_t data_bytes = raw.voxels * raw.bytes_per_voxel;
   // Before nifti_image_read: it reads header extensions up to vox_offset.
   if (raw.single_file) require_voxel_bytes(header_path, raw.vox_offset, data_bytes, path);
+  require_intact_gzip(header_path, path);
 
   file.nim.reset(nifti_image_read(path.c_str(), /*read_data=*/0));
   require(file.nim != nullptr, std::string(kNotNifti) + " (bad or truncated header)", path,
@@ -365,6 +411,7 @@ OpenedNifti open_header(const std::string& path) {
   const bool checked = raw.single_file && header_path == nim.iname &&
                        nim.iname_offset == raw.vox_offset;
   if (!checked) require_voxel_bytes(nim.iname, nim.iname_offset, data_bytes, path);
+  if (nim.iname != header_path) require_intact_gzip(nim.iname, path);
   return file;
 }
 
@@ -542,11 +589,15 @@ void write_file(const std::string& path, nifti_image& nim) {
   require(!znz_isnull(file), "cannot create file", path, "check the folder and its permissions");
   const char no_extension[4] = {0, 0, 0, 0};
   const std::size_t bytes = std::size_t(nim.nvox) * std::size_t(nim.nbyper);
+  errno = 0;
   bool ok = znzwrite(&header, sizeof header, 1, file) == 1 &&
             znzwrite(no_extension, 1, sizeof no_extension, file) == sizeof no_extension &&
             znzwrite(nim.data, 1, bytes, file) == bytes;
+  const int write_errno = errno;
   ok = znzclose(file) == 0 && ok;  // closing flushes (and finishes the gzip stream)
-  require(ok, "cannot write file", path, "check free disk space");
+  const int error = write_errno ? write_errno : errno;
+  require(ok, error ? "cannot write file: " + system_reason(error) : std::string("cannot write file"), path,
+          "check free disk space");
   out.commit();
 }
 

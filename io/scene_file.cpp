@@ -655,9 +655,10 @@ OutputSpec read_output(const Section& s, const ModelSpec& model) {
 /// Runs after everything is read: shapes may come before the materials they name. A tissue
 /// needs a [materials.X] table unless it has a default material.
 void check_labels(Scene& scene, const std::string& source) {
+  const std::vector<std::string> defaults = default_material_names();  // outlives the views in `names`
   Keys names;
   for (const auto& entry : scene.materials) names.push_back(entry.first);
-  for (const std::string& d : default_material_names()) names.push_back(d);
+  for (const std::string& d : defaults) names.push_back(d);
   auto resolve = [&](const std::string& tissue, int line, const std::string& key) {
     if (scene.materials.count(tissue) || tissue == "air") return;  // "air": not modelled
     if (auto d = default_material(tissue)) {

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Bounded libFuzzer runs of the NIfTI reader and the DICOM series assembly.
+# Bounded libFuzzer runs of the NIfTI reader, the DICOM series assembly and the scene-file parser.
 #
 # Usage (from any folder):
-#   bash scripts/fuzz.sh                       # build both targets, fuzz each for 15 s
+#   bash scripts/fuzz.sh                       # build the targets, fuzz each for 15 s
 #   FUZZ_SECONDS=600 bash scripts/fuzz.sh      # longer runs
 #   FUZZ_TARGETS=fuzz_nifti bash scripts/fuzz.sh   # one target only
 #   VB_FUZZ_VERBOSE=1 build/fuzz/fuzz_nifti FILE   # replay one input (a finding, a seed);
@@ -14,9 +14,9 @@
 #
 # Environment:
 #   BUILD_DIR      CMake build folder (default build, relative to the repository root)
-#   FUZZ_SECONDS   seconds of fuzzing per target (default 15); both targets run at once
+#   FUZZ_SECONDS   seconds of fuzzing per target (default 15); the targets run at once
 #   FUZZ_CXX       compiler (default clang++)
-#   FUZZ_TARGETS   targets to build and run (default "fuzz_nifti fuzz_dicom_series")
+#   FUZZ_TARGETS   targets to build and run (default "fuzz_nifti fuzz_dicom_series fuzz_scene_file")
 #
 # Targets and objects go to ${BUILD_DIR}/fuzz/ (objects are rebuilt only when a source, a header
 # it includes or the flags change). Each target fuzzes a fresh copy of tests/fuzz/corpus/<name>/
@@ -33,7 +33,7 @@ build_dir=${BUILD_DIR:-build}
 [[ $build_dir = /* ]] || build_dir=$root/$build_dir
 seconds=${FUZZ_SECONDS:-15}
 cxx=${FUZZ_CXX:-clang++}
-targets=${FUZZ_TARGETS:-fuzz_nifti fuzz_dicom_series}
+targets=${FUZZ_TARGETS:-fuzz_nifti fuzz_dicom_series fuzz_scene_file}
 out=$build_dir/fuzz
 
 fail_setup() {
@@ -47,18 +47,20 @@ fail_setup() {
 command -v "$cxx" >/dev/null || fail_setup "$cxx not found: install clang (and libclang-rt-dev)"
 [[ $seconds =~ ^[0-9]+$ && $seconds -gt 0 ]] || fail_setup "FUZZ_SECONDS must be a positive integer"
 
-cxxflags=(-std=c++20 -g -O1 -fsanitize=fuzzer,address,undefined -fno-omit-frame-pointer
+cxxflags=(-std=c++20 -g -O1 -fsanitize=fuzzer,address,undefined,float-cast-overflow -fno-omit-frame-pointer
+  -DTOML_HEADER_ONLY=0 -DTOML_SHARED_LIB=1
   -I"$root" -I"$build_dir/generated" -I/usr/include/eigen3 -I/usr/include/nifti)
 libs=(-ldcmjpls -ldcmjpeg -ldcmimage -ldcmimgle -ldcmdata -loflog -lofstd
-  -lnifti2 -lznz -lz -lm -lpthread)
+  -lnifti2 -lznz -ltomlplusplus -lz -lm -lpthread)
 
 # Project sources each target needs (listed explicitly; keep in step with their #includes).
 common_sources=(engine/error.cpp io/atomic_file.cpp)
 declare -A target_sources=(
   [fuzz_nifti]="tests/fuzz/fuzz_nifti.cpp io/nifti_io.cpp"
   [fuzz_dicom_series]="tests/fuzz/fuzz_dicom_series.cpp io/dicom_read.cpp io/dicom_pixels.cpp io/dicom_deflate.cpp io/dicom_attributes.cpp"
+  [fuzz_scene_file]="tests/fuzz/fuzz_scene_file.cpp io/scene_file.cpp io/toml_section.cpp io/toml_text.cpp io/did_you_mean.cpp io/indenter_path_csv.cpp io/numeric_csv.cpp engine/material/default_materials.cpp engine/material/hyperelastic.cpp engine/loads/posture.cpp"
 )
-declare -A target_corpus=([fuzz_nifti]=nifti [fuzz_dicom_series]=dicom)
+declare -A target_corpus=([fuzz_nifti]=nifti [fuzz_dicom_series]=dicom [fuzz_scene_file]=scene)
 for t in $targets; do
   [[ -n ${target_sources[$t]:-} ]] || fail_setup "unknown target $t (known: ${!target_sources[*]})"
 done

@@ -15,6 +15,7 @@ packages=(
   libopenmpi-dev openmpi-bin
   python3-dolfinx
   plastimatch elastix dicom3tools python3-meshio
+  ccache
 )
 
 missing=()

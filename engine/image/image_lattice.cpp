@@ -9,6 +9,10 @@
 namespace vb {
 namespace {
 
+std::size_t modelled_voxels(const TissueMap& map) {
+  return std::size_t(std::count_if(map.tissue.begin(), map.tissue.end(), [](std::uint8_t t) { return t != 0; }));
+}
+
 /// "air" (or any tissue named so) marks voxels that are not modelled.
 bool is_air(const std::string& tissue) { return tissue == "air"; }
 
@@ -114,7 +118,8 @@ TissueMap classify_image(const ModelSpec& model, const ImageVolume& ct, const Im
   return map;
 }
 
-LabelVolume lattice_volume_from_image(const ModelSpec& model, const ImageVolume& ct, const TissueMap& map) {
+LabelVolume lattice_volume_from_image(const ModelSpec& model, const ImageVolume& ct, const TissueMap& map,
+                                      Precision precision, const MemoryBudget& budget) {
   const Eigen::Matrix3d A = ct.affine_lps_m.topLeftCorner<3, 3>();
   const Eigen::Vector3d s = ct.spacing_m();
   require((s.array() > 0).all() && s.allFinite(), "the CT has a zero or invalid voxel spacing", "model.image");
@@ -137,11 +142,17 @@ LabelVolume lattice_volume_from_image(const ModelSpec& model, const ImageVolume&
   // coordinate (metres from CT voxel 0's centre); start is the edge of the first modelled voxel.
   LabelVolume vol;
   Eigen::Vector3d start;
+  std::array<double, 3> cells{};
   for (int a = 0; a < 3; ++a) {
     start[a] = (lo[a] - 0.5) * s[a];
     const double extent = (hi[a] - lo[a] + 1) * s[a];
-    vol.dims[a] = std::max(1, int(std::ceil(extent / h - 1e-9)));
+    cells[std::size_t(a)] = std::ceil(extent / h - 1e-9);
   }
+  vol.dims = grid_dims(cells, h, "model.spacing");  // range-checked before the cast
+  // Elements: the modelled CT voxels' volume in lattice voxels.
+  const double elements = double(modelled_voxels(map)) * s.prod() / (h * h * h);
+  require_model_fits_memory(double(vol.dims[0]) * vol.dims[1] * vol.dims[2], std::max(1.0, elements), h, precision,
+                            budget, "model.spacing");
   vol.spacing_m = h;
   vol.rotation = R;
   vol.origin_m = ct.world_of_index(Eigen::Vector3d::Zero()) + R * (start + Eigen::Vector3d::Constant(0.5 * h));

@@ -4,6 +4,7 @@
 /// isotropic grid aligned with the image axes (oblique CTs keep their orientation).
 #include "engine/image/image_volume.hpp"
 #include "engine/lattice/lattice.hpp"
+#include "engine/lattice/model_memory.hpp"
 #include "engine/scene/scene.hpp"
 
 namespace vb {
@@ -22,6 +23,9 @@ TissueMap classify_image(const ModelSpec& model, const ImageVolume& ct, const Im
 /// Resamples the classified image onto an isotropic grid of spacing model.spacing_m (0: the
 /// image's largest spacing), aligned with the image axes, cropped to the modelled voxels.
 /// Nearest-neighbour: each lattice voxel takes the tissue of the CT voxel containing its centre.
-LabelVolume lattice_volume_from_image(const ModelSpec& model, const ImageVolume& ct, const TissueMap& map);
+/// A grid of 2^31 voxels or more, or a model whose estimated memory (`precision` on the device)
+/// exceeds `budget`, is refused before the grid is allocated.
+LabelVolume lattice_volume_from_image(const ModelSpec& model, const ImageVolume& ct, const TissueMap& map,
+                                      Precision precision = Precision::Float, const MemoryBudget& budget = {});
 
 }  // namespace vb

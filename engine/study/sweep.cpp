@@ -1,5 +1,6 @@
 #include "engine/study/sweep.hpp"
 
+#include <algorithm>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -8,6 +9,7 @@
 
 #include "engine/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/file_hash.hpp"
 #include "io/scene_file.hpp"
 #include "io/scene_overrides.hpp"
 
@@ -33,6 +35,13 @@ std::string with_absolute_paths(std::string text, const std::string& source, con
   return text;
 }
 
+/// SHA-256 of each input file or folder, by path: a resumed sweep whose data changed is refused.
+nlohmann::json input_hashes(const std::vector<std::string>& files) {
+  nlohmann::json hashes = nlohmann::json::object();
+  for (const std::string& file : files) hashes[file] = content_sha256(file);
+  return hashes;
+}
+
 }  // namespace
 
 SweepPlan plan_sweep(const std::string& scene_path, std::vector<SweepParameter> parameters) {
@@ -51,12 +60,18 @@ SweepPlan plan_sweep(const std::string& scene_path, std::vector<SweepParameter> 
     try {
       std::string text = apply_scene_overrides(plan.scene_text, scene_path, overrides);
       text = with_absolute_paths(text, scene_path, base_dir);
-      (void)parse_scene_text(text, scene_path);  // every strict check of a scene file
+      const Scene scene = parse_scene_text(text, scene_path);  // every strict check of a scene file
+      for (const std::string* file : {&scene.model.image_path, &scene.model.labels_path})
+        if (!file->empty()) plan.input_files.push_back(*file);
+      for (const IndenterSpec& indenter : scene.indenters)
+        if (!indenter.path_file.empty()) plan.input_files.push_back(indenter.path_file);
       plan.case_scenes.push_back(std::move(text));
     } catch (const Error& e) {
       throw Error(which + ": " + e.problem(), e.location(), e.hint());
     }
   }
+  std::sort(plan.input_files.begin(), plan.input_files.end());
+  plan.input_files.erase(std::unique(plan.input_files.begin(), plan.input_files.end()), plan.input_files.end());
   return plan;
 }
 
@@ -70,7 +85,9 @@ SweepOutcome run_sweep(const SweepPlan& plan, const SweepOptions& options, const
     try {
       ensure_output_dir(options.out_dir);
       lock.emplace(folder.path(".lock"));
-      outcome.warnings = folder.open(sweep_definition(plan.grid, plan.scene_path, plan.scene_text, options.outputs));
+      nlohmann::json definition = sweep_definition(plan.grid, plan.scene_path, plan.scene_text, options.outputs);
+      definition["inputs"] = input_hashes(plan.input_files);
+      outcome.warnings = folder.open(definition);
     } catch (...) {
       error = std::current_exception();
     }

@@ -17,6 +17,7 @@ struct SweepPlan {
   std::string scene_text;                ///< its text
   SweepGrid grid{{}};
   std::vector<std::string> case_scenes;  ///< scene text of each case
+  std::vector<std::string> input_files;  ///< every data file or folder the cases' scenes name, sorted
 };
 
 /// Reads the scene and builds every case's scene text: the base text with the case's overrides,

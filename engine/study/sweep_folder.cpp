@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 
 #include "engine/error.hpp"
 #include "io/atomic_file.hpp"
@@ -45,7 +46,16 @@ std::string difference(const nlohmann::json& was, const nlohmann::json& now) {
     if (a[i] != b[i])
       return "--vary " + a[i].value("key", "") + " had the values " + a[i]["values"].dump() + ", now " + b[i]["values"].dump();
   }
-  return was == now ? "" : "sweep.json differs";
+  if (was.contains("inputs")) {
+    const nlohmann::json& before = was["inputs"];
+    const nlohmann::json after = now.value("inputs", nlohmann::json::object());
+    for (const auto& [file, hash] : after.items())
+      if (before.contains(file) && before[file] != hash)
+        return "the input file " + file + " has changed since the sweep started (its SHA-256 differs)";
+  }
+  nlohmann::json compared = now;  // a sweep.json from before input hashes were recorded has none
+  if (!was.contains("inputs")) compared.erase("inputs");
+  return was == compared ? "" : "sweep.json differs";
 }
 
 }  // namespace
@@ -80,6 +90,16 @@ std::vector<std::string> SweepFolder::open(const nlohmann::json& definition) con
   record["version"] = config::version;
   record["git_commit"] = config::git_commit;
   if (!fs::exists(file)) {
+    // A new sweep: the names it writes must not be someone else's files (never replaced).
+    std::error_code ec;
+    for (const char* name : {"metrics.csv", "timing.csv", "plots"})
+      if (fs::exists(fs::symlink_status(path(name), ec)))
+        throw Error(std::string("the output folder holds '") + name + "', which is not a VoxBreast sweep's (no sweep.json)",
+                    dir_, "move it away or choose another --out");
+    for (const fs::directory_entry& e : fs::directory_iterator(path("cases"), ec))
+      throw Error("the output folder's cases/ holds '" + e.path().filename().string() +
+                      "', which is not a VoxBreast sweep's (no sweep.json)",
+                  dir_, "move it away or choose another --out");
     write_text_atomically(file, record.dump(2) + "\n");
     return {};
   }
@@ -135,9 +155,13 @@ void SweepFolder::remove_leftovers(const std::function<bool(std::size_t)>& owned
   std::error_code ec;
   std::vector<fs::path> leftovers;
   for (const fs::directory_entry& e : fs::directory_iterator(path("cases"), ec)) {
-    const std::string name = e.path().filename().string();  // .0003.work-r0-p123, .0003.old-p123
-    if (name.size() < 3 || name[0] != '.') continue;
-    const std::size_t id = std::strtoull(name.c_str() + 1, nullptr, 10);
+    const std::string name = e.path().filename().string();
+    // Only the names this class makes (.0003.work-r0-p123, .0003.old-p123): a folder of someone
+    // else's that merely starts like one is never removed.
+    static const std::regex ours(R"(\.([0-9]+)\.(work-r[0-9]+-p[0-9]+|old-p[0-9]+))");
+    std::smatch match;
+    if (!std::regex_match(name, match, ours)) continue;
+    const std::size_t id = std::strtoull(match[1].str().c_str(), nullptr, 10);
     if (id >= 1 && id <= case_count_ && owned(id - 1)) leftovers.push_back(e.path());
   }
   for (const fs::path& p : leftovers) fs::remove_all(p, ec);

@@ -33,6 +33,36 @@ else fail "sample scene"; cat "$work/sample.txt"; fi
 h5dump -H "$work/sample/result.h5" >"$work/h5.txt" 2>&1
 if grep -q '"displacement_m"' "$work/h5.txt"; then pass "result.h5 readable"; else fail "result.h5"; fi
 
+# --- whole output folders (docs/OUTPUTS.md): a second writer is refused while the folder is locked;
+# a rerun removes a killed run's temporary file and records its files in the manifest; a folder
+# holding someone else's summary.json is refused before computing and left as it was.
+touch "$work/sample/.result.h5.tmp-999999-0"
+python3 -c 'import fcntl, os, sys, time
+fd = os.open(sys.argv[1], os.O_RDONLY); fcntl.flock(fd, fcntl.LOCK_EX); print("held", flush=True); time.sleep(60)' \
+  "$work/sample" >"$work/lock.txt" & holder=$!
+for _ in $(seq 50); do grep -q held "$work/lock.txt" 2>/dev/null && break; sleep 0.1; done
+if ! "$bin" simulate "$root/data-samples/breast_phantom.toml" --out "$work/sample" --quiet >/dev/null 2>"$work/locked.err" \
+   && grep -q "another VoxBreast run is writing to this output folder" "$work/locked.err"
+then pass "a second run into a locked output folder is refused"
+else fail "lock"; cat "$work/locked.err"; fi
+kill "$holder"; wait "$holder" 2>/dev/null
+if "$bin" simulate "$root/data-samples/breast_phantom.toml" --out "$work/sample" --quiet >/dev/null 2>&1 \
+   && [ ! -e "$work/sample/.result.h5.tmp-999999-0" ] && python3 - "$work/sample" <<'PY'
+import json, os, sys
+d = sys.argv[1]
+m = json.load(open(os.path.join(d, ".voxbreast-manifest.json")))["runs"]["simulate"]
+assert {"summary.json", "metrics.csv", "result.h5", "surface.vtp"} <= set(m), m
+assert sorted(m) == sorted(e for e in os.listdir(d) if not e.startswith(".")), (m, os.listdir(d))
+PY
+then pass "a rerun removes a killed run's temporary file and lists every output in the manifest"
+else fail "rerun manifest"; fi
+mkdir -p "$work/foreign" && echo mine >"$work/foreign/summary.json"
+if ! "$bin" simulate "$root/data-samples/breast_phantom.toml" --out "$work/foreign" --quiet >/dev/null 2>"$work/foreign.err" \
+   && grep -q "holds 'summary.json', which no earlier VoxBreast run recorded writing" "$work/foreign.err" \
+   && [ "$(cat "$work/foreign/summary.json")" = mine ] && [ "$(ls -A "$work/foreign")" = summary.json ]
+then pass "someone else's summary.json stops the run before it computes"
+else fail "foreign summary.json"; cat "$work/foreign.err"; fi
+
 # --- the main job: the bundled phantom CT (DICOM) to DVF, warped CT and summary
 if "$bin" simulate "$root/data-samples/phantom/scene_dicom.toml" --out "$work/ct" --quiet >"$work/ct.txt" 2>&1 \
    && /usr/bin/python3 - "$work/ct" <<'PY'
@@ -79,7 +109,7 @@ series_uid() { dcmdump +P 0020,000e "$1/CT00001.dcm" 2>/dev/null; }  # of the se
 first_uid=$(series_uid "$work/ct/warped_ct_dicom"); slices=$(ls "$work/ct/warped_ct_dicom" | wc -l)
 if "$bin" simulate "$root/data-samples/phantom/scene_dicom.toml" --out "$work/ct" --quiet >/dev/null 2>&1 \
    && [ -n "$first_uid" ] && [ "$(series_uid "$work/ct/warped_ct_dicom")" != "$first_uid" ] \
-   && [ "$(ls "$work/ct/warped_ct_dicom" | wc -l)" = "$slices" ] && [ -z "$(ls -A "$work/ct" | grep '^\.')" ]
+   && [ "$(ls "$work/ct/warped_ct_dicom" | wc -l)" = "$slices" ] && [ -z "$(ls -A "$work/ct" | grep '^\.' | grep -v '^\.voxbreast-manifest\.json$')" ]
 then pass "a rerun into the same folder replaces its warped CT series"
 else fail "rerun replaces the warped series"; fi
 h5_inode=$(stat -c %i "$work/ct/result.h5") && touch "$work/ct/warped_ct_dicom/notes.txt"  # a rewrite is a new inode

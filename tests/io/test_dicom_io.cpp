@@ -767,6 +767,25 @@ TEST(DicomRead, DeflatedDatasetLengthsAreCheckedBeforeDcmtkReadsThem) {
   }
 }
 
+/// A deflated dataset has no checksum; what it has is the deflate stream's own end (its final
+/// block). A file cut a few bytes short of it inflated all its attributes and read as complete.
+/// Such a stream is now refused, and so is one whose bits are corrupt.
+TEST_F(DicomSeriesTest, DeflatedStreamMustEndCleanly) {
+  if (!have_tool("dcmconv")) GTEST_SKIP() << "dcmconv missing (Debian package dcmtk)";
+  const fs::path first = files_in(series_).front();
+  const fs::path deflated = tmp_ / "deflated.dcm";
+  ASSERT_EQ(run_command("dcmconv +td " + quoted(first) + " " + quoted(deflated) + " 2>&1").exit_code, 0);
+  std::ifstream in(deflated, std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  ASSERT_GT(bytes.size(), 64u);
+  for (std::size_t cut = 1; cut <= 4; ++cut) {
+    SCOPED_TRACE("cut " + std::to_string(cut));
+    fs::path slice;
+    const std::string message = cheap_failure(bytes.substr(0, bytes.size() - cut), slice);
+    EXPECT_NE(message.find("the deflated dataset is corrupt or truncated"), std::string::npos) << message;
+  }
+}
+
 TEST(DicomRead, FolderErrors) {
   TempDir tmp;
   EXPECT_NE(error_of([&] { read_dicom_series((tmp / "absent").string()); }).find("not a folder"),

@@ -700,13 +700,19 @@ TEST_F(NiftiIo, FuzzRegressionTinyFileClaimingHugeImage) {
   }
 }
 
-/// The gzip trailer counts only the last member of a multi-member file: the check then counts the
-/// decompressed stream instead, so such a file still reads, and a short one is still refused.
-TEST_F(NiftiIo, MultiMemberGzipIsMeasuredByItsStream) {
+/// 40 × 30 × 20 voxels counting 0, 1, ... 996 over and over: enough that gzip output is long.
+ImageVolume counting_volume() {
   ImageVolume image = oblique_grid();
   image.dims = {40, 30, 20};
   image.values.resize(image.voxel_count());
   for (std::size_t v = 0; v < image.values.size(); ++v) image.values[v] = float(v % 997);
+  return image;
+}
+
+/// The gzip trailer counts only the last member of a multi-member file: the check then counts the
+/// decompressed stream instead, so such a file still reads, and a short one is still refused.
+TEST_F(NiftiIo, MultiMemberGzipIsMeasuredByItsStream) {
+  const ImageVolume image = counting_volume();
   write_nifti(path("plain.nii"), image, NiftiType::Float32);
   const std::vector<char> bytes = file_bytes(path("plain.nii"));
   const auto two_members = [&](std::size_t size) {
@@ -724,6 +730,38 @@ TEST_F(NiftiIo, MultiMemberGzipIsMeasuredByItsStream) {
 
   write_bytes(path("short.nii.gz"), two_members(bytes.size() - 100));
   expect_error([&] { read_nifti(path("short.nii.gz")); }, path("short.nii.gz"), "truncated");
+}
+
+/// nifti_clib reads only the bytes a header asks for, so it never reached the gzip trailer where
+/// zlib checks the CRC-32 and the length: a .nii.gz with corrupt voxels read as a valid image.
+/// Every gzip file is now checked to its end before it is used.
+TEST_F(NiftiIo, CorruptGzipStreamIsRefused) {
+  const ImageVolume image = counting_volume();
+  write_nifti(path("good.nii.gz"), image, NiftiType::Float32);
+  const std::vector<char> good = file_bytes(path("good.nii.gz"));
+  ASSERT_GT(good.size(), 1000u);
+  EXPECT_EQ(read_nifti(path("good.nii.gz")).values, image.values);
+
+  const auto flipped = [&](std::size_t at) {
+    std::vector<char> bytes = good;
+    bytes[at] = char(bytes[at] ^ 0x01);
+    return bytes;
+  };
+  const std::vector<std::pair<std::string, std::vector<char>>> cases = {
+      {"crc.nii.gz", flipped(good.size() - 8)},      // the CRC-32 in the trailer
+      {"isize.nii.gz", flipped(good.size() - 2)},    // the length, said larger than it is
+      {"middle.nii.gz", flipped(good.size() / 2)}};  // a bit inside the voxels' deflate data
+  for (const auto& [name, bytes] : cases) {
+    SCOPED_TRACE(name);
+    write_bytes(path(name), bytes);
+    expect_error([&] { read_nifti(path(name)); }, path(name), "corrupt gzip stream");
+    std::vector<float> u;
+    expect_error([&] { read_nifti_displacement(path(name), u); }, path(name), "corrupt gzip stream");
+  }
+  std::vector<char> trailing = good;
+  trailing.insert(trailing.end(), {'j', 'u', 'n', 'k'});
+  write_bytes(path("trailing.nii.gz"), trailing);
+  expect_error([&] { read_nifti(path("trailing.nii.gz")); }, path("trailing.nii.gz"), "corrupt gzip stream");
 }
 
 // ---- external check through nibabel ------------------------------------------------------------

@@ -131,8 +131,74 @@ TEST(Lattice, TooManyVoxelsIsAnErrorNamingTheExtentInMetres) {
     FAIL() << "expected an error";
   } catch (const Error& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("0.002 × 0.002 × 0.002 m, 8000000000 voxels"), std::string::npos) << what;
+    EXPECT_NE(what.find("0.002 × 0.002 × 0.002 m, 8e+09 voxels"), std::string::npos) << what;
     EXPECT_NE(what.find("lengths are in metres"), std::string::npos) << what;
+  }
+}
+
+/// A coordinate of 1e300 m made a one-layer model (an out-of-range double → integer cast), and a
+/// spacing of 1e-9 m printed "-9223372036854775808 voxels": both are refused before any cast.
+TEST(Lattice, CoordinatesAndSpacingsOutOfRangeAreRefusedBeforeAnyCast) {
+  Scene far = test::box_scene(2, 2, 2, 0.001);
+  far.model.shapes[0].min_m = Vec3(1e300, 0, 0);
+  far.model.shapes[0].max_m = Vec3(1e300, 0.002, 0.002);
+  try {
+    voxelise_shapes(far);
+    FAIL() << "a shape at 1e300 m was voxelised";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the shapes reach 1e+300 m from the origin (at most 100 m)"), std::string::npos)
+        << e.what();
+  }
+  Scene fine = test::box_scene(2, 2, 2, 0.001);
+  fine.model.shapes[0].max_m = Vec3(0.05, 0.05, 0.05);
+  fine.model.spacing_m = 1e-9;
+  try {
+    voxelise_shapes(fine);
+    FAIL() << "a 5e7³-voxel grid was accepted";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("1.25e+23 voxels"), std::string::npos) << what;
+    EXPECT_EQ(what.find("-9223372036854775808"), std::string::npos) << what;
+  }
+}
+
+/// A 3.9e9-voxel model passed the size guard and died minutes later in a bare std::bad_alloc.
+/// The memory is estimated before the grid is allocated, and the refusal names the estimate and
+/// a spacing that fits, which then passes the same check.
+TEST(Lattice, ModelsLargerThanTheMemoryAreRefusedWithASpacingThatFits) {
+  Scene s = test::box_scene(2, 2, 2, 0.001);
+  s.model.shapes[0].max_m = Vec3(0.3, 0.3, 0.3);  // 2.7e7 voxels, all occupied
+  MemoryBudget budget;
+  budget.host_bytes = std::uint64_t(1) << 30;  // 1 GiB
+  std::string hint;
+  try {
+    voxelise_shapes(s, budget);
+    FAIL() << "a 2.7e7-element model was accepted within 1 GiB";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("needs about 25.9 GiB of host memory (2.7e+07 voxels, about 2.7e+07 elements) but 1 GiB are"),
+              std::string::npos)
+        << what;
+    hint = e.hint();
+  }
+  const std::size_t at = hint.find("a spacing of ");
+  ASSERT_NE(at, std::string::npos) << hint;
+  const double fitting_mm = std::stod(hint.substr(at + 13));
+  EXPECT_GT(fitting_mm, 1.0);
+  s.model.spacing_m = 1e-3 * fitting_mm;
+  const LabelVolume volume = voxelise_shapes(s, budget);
+  EXPECT_LT(estimated_host_bytes(double(volume.labels.size()), double(volume.labels.size())), double(budget.host_bytes));
+
+  MemoryBudget device;
+  device.device_bytes = std::uint64_t(1) << 28;  // 256 MiB
+  device.device_name = "small";
+  s.model.spacing_m = 0.001;
+  try {
+    voxelise_shapes(s, device);
+    FAIL() << "a model larger than the device was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("of device memory"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'small' has 0.25 GiB"), std::string::npos) << e.what();
   }
 }
 

@@ -12,6 +12,8 @@
 #include <thread>
 
 #include "engine/error.hpp"
+#include "engine/study/mpi_world.hpp"
+#include "engine/study/sweep.hpp"
 #include "engine/study/sweep_folder.hpp"
 #include "engine/study/sweep_runner.hpp"
 #include "engine/study/sweep_tables.hpp"
@@ -111,12 +113,14 @@ TEST_F(SweepRunnerTest, StoppedAndRestartedSweepGivesTheSameMetricsAndRunsEachCa
   EXPECT_NE(partial.find(",pending,"), std::string::npos);
   // A killed run leaves a half-written working folder behind: it must not count as finished.
   fs::create_directories(root_ / "resumed" / "cases" / ".0004.work-r0-p1");
+  fs::create_directories(root_ / "resumed" / "cases" / ".0004.notes");  // someone else's
   write_text_atomically((root_ / "resumed" / "cases" / ".0004.work-r0-p1" / "summary.json").string(), "{\"steps\": ");
   const std::string resumed = sweep(root_ / "resumed", {}, &ran);
   EXPECT_EQ(ran.size(), 8u);
   EXPECT_EQ(std::set<std::size_t>(ran.begin(), ran.end()).size(), 8u) << "a finished case ran again";
   EXPECT_EQ(resumed, uninterrupted);
   EXPECT_FALSE(fs::exists(root_ / "resumed" / "cases" / ".0004.work-r0-p1"));
+  EXPECT_TRUE(fs::exists(root_ / "resumed" / "cases" / ".0004.notes")) << "a folder the sweep did not make was removed";
 }
 
 TEST_F(SweepRunnerTest, RanksTakeEveryNthCaseAndTogetherMatchOneProcess) {
@@ -176,6 +180,54 @@ TEST_F(SweepRunnerTest, AnotherGridInTheSameFolderIsAnError) {
   }
   EXPECT_THROW(folder.open(sweep_definition(g, "test.toml", "[p]\nx = 1\n", "minimal")), Error);
   EXPECT_THROW(folder.open(sweep_definition(g, "test.toml", "[p]\nx = 0\n", "full")), Error);
+}
+
+/// The scene text of a resumed sweep can stay the same while the CT it names changes: the sweep
+/// records a SHA-256 of every input file and refuses to resume over changed data.
+TEST_F(SweepRunnerTest, ResumeIsRefusedWhenAnInputFileChanged) {
+  const fs::path sample = fs::path(VOXBREAST_SOURCE_DIR) / "data-samples" / "phantom";
+  const fs::path data = root_ / "data";
+  fs::create_directories(data);
+  for (const char* file : {"scene.toml", "ct.nii.gz", "labels.nii.gz"}) fs::copy_file(sample / file, data / file);
+  const SweepPlan plan = plan_sweep((data / "scene.toml").string(), {parse_vary("materials.skin.E=40000,50000")});
+  EXPECT_EQ(plan.input_files, (std::vector<std::string>{(data / "ct.nii.gz").string(), (data / "labels.nii.gz").string()}));
+  const MpiWorld world;
+  SweepOptions options;
+  options.out_dir = (root_ / "sweep").string();
+  options.stop_after = 1;  // killed after one case
+  const SweepCaseRunner run_case = [](const SweepCase& c, std::size_t) {
+    write_text_atomically(c.work_dir + "/summary.json", "{\"steps\": 1}");
+  };
+  run_sweep(plan, options, world, run_case);
+  run_sweep(plan, options, world, run_case);  // resumes: nothing changed
+  fs::copy_file(data / "labels.nii.gz", data / "ct.nii.gz", fs::copy_options::overwrite_existing);
+  try {
+    run_sweep(plan, options, world, run_case);
+    ADD_FAILURE() << "resumed over a changed CT";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the input file " + (data / "ct.nii.gz").string() + " has changed"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+/// A new sweep refused a folder whose metrics.csv or cases/ it would replace or mix with.
+TEST_F(SweepRunnerTest, ANewSweepNeverReplacesFilesItDidNotWrite) {
+  const SweepGrid g = grid();
+  for (const char* name : {"metrics.csv", "timing.csv", "cases/0001"}) {
+    const fs::path dir = root_ / ("foreign_" + std::to_string(name[0] == 'c' ? 2 : name[0] == 'm' ? 0 : 1));
+    fs::create_directories((dir / name).parent_path());
+    write_text_atomically((dir / name).string(), "mine");
+    const SweepFolder folder(dir.string(), g.size());
+    try {
+      folder.open(sweep_definition(g, "test.toml", "[p]\nx = 0\n", "minimal"));
+      ADD_FAILURE() << "a folder holding " << name << " was taken";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("which is not a VoxBreast sweep's"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(read_file(dir / name), "mine");
+    EXPECT_FALSE(fs::exists(dir / "sweep.json"));
+  }
 }
 
 TEST_F(SweepRunnerTest, OneSweepAtATimePerFolder) {
