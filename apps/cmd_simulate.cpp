@@ -1,5 +1,6 @@
 // voxbreast simulate SCENE.toml --out DIR — runs a scene and writes summary.json, metrics.csv and result.h5.
 //   voxbreast simulate data-samples/breast_phantom.toml --out out/phantom
+#include <chrono>
 #include <cstdio>
 #include <memory>
 
@@ -14,16 +15,25 @@ namespace {
 struct SimulateOptions {
   std::string scene, out, device, precision, series;
   bool quiet = false, allow_gaps = false;
+  double status_interval_s = 10;
 };
 
 int run_simulate(const SimulateOptions& o) {
+  const auto command_start = std::chrono::steady_clock::now();
   Scene scene = load_scene(o.scene, o.precision);
   if (!o.series.empty()) scene.model.series_uid = o.series;
   scene.model.allow_gaps = scene.model.allow_gaps || o.allow_gaps;
   const OutputDir output_dir(o.out);  // fail before computing, not after
   const ClContext cl(select_device(o.device));
-  Progress bar(!o.quiet);
+  Progress bar(!o.quiet, o.status_interval_s);
   SimulationOptions options;
+  options.command_start = command_start;
+  // Each run ends at its equilibrium tolerance: the reference state's solves at their own.
+  double tolerance = scene.stop.equilibrium;
+  options.on_phase = [&](const std::string& phase) {
+    bar.phase(phase);
+    tolerance = phase == "reference state" ? reference_state_scene(scene).stop.equilibrium : scene.stop.equilibrium;
+  };
   options.on_start = [&](const PreparedModel& model, const Simulator& sim) {
     if (!o.quiet)
       std::fprintf(stderr, "voxbreast: %zu elements, %zu connections, dt = %.3g s (%s), device %s, %s\n",
@@ -33,19 +43,20 @@ int run_simulate(const SimulateOptions& o) {
   };
   options.on_progress = [&](const RunProgress& p) {
     char text[160];
-    std::snprintf(text, sizeof text, "step %lld  t=%.4g s  residual %.2e  speed %.2e", (long long)p.step, p.time_s,
-                  p.residual, p.speed_ratio);
-    bar.update(double(p.step) / double(p.max_steps), text);
+    std::snprintf(text, sizeof text, "step %lld  t=%.4g s  speed %.2e", (long long)p.step, p.time_s, p.speed_ratio);
+    if (tolerance > 0) bar.converge(p.residual, tolerance, text);
+    else bar.update(double(p.step) / double(p.max_steps), text);  // no equilibrium rule: the step limit ends the run
   };
+  options.on_image_progress = [&](const std::string& what, double fraction) { bar.update(fraction, what); };
   options.on_reference_iteration = [&](const ReferenceIteration& r) {
     if (o.quiet) return;
-    bar.finish();
+    bar.phase("reference state");
     std::fprintf(stderr, "voxbreast: unloaded state, iteration %d (step %.3g): lands %.4f mm from the CT (rms %.4f mm, %lld steps)\n",
                  r.iteration, r.step, 1e3 * r.residual_max_m, 1e3 * r.residual_rms_m, (long long)r.steps);
   };
   options.on_perturbed_run = [&](const PerturbedRun& r) {
     if (o.quiet) return;
-    bar.finish();
+    bar.phase("reproducibility");
     std::fprintf(stderr, "voxbreast: posture %d/%d %s device (roll %.2f, pitch %.2f, yaw %.2f deg): tumour at (%.2f, %.2f, %.2f) mm%s\n",
                  r.index, scene.reproducibility.perturbations, r.device ? "with" : "without", r.rpy_deg.x(),
                  r.rpy_deg.y(), r.rpy_deg.z(), 1e3 * r.tumour_centroid_m.x(), 1e3 * r.tumour_centroid_m.y(),
@@ -96,6 +107,9 @@ Command add_simulate(CLI::App& app) {
   sub->add_option("--series", o->series, "DICOM SeriesInstanceUID when the CT folder holds several series");
   sub->add_flag("--allow-gaps", o->allow_gaps, "accept unevenly spaced DICOM slices (with a warning)");
   sub->add_flag("--quiet,-q", o->quiet, "no progress display");
+  sub->add_option("--status-interval", o->status_interval_s,
+                  "seconds between status lines on stderr when it is not a terminal (default 10)")
+      ->check(CLI::PositiveNumber);
   return {sub, [o] { return run_simulate(*o); }};
 }
 

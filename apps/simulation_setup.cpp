@@ -3,12 +3,15 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "engine/error.hpp"
 #include "engine/image/image_lattice.hpp"
+#include "engine/image/structure_set.hpp"
 #include "engine/lattice/voxelise.hpp"
 #include "engine/sim/device_memory.hpp"
 #include "engine/sim/simulator.hpp"
 #include "io/dicom_io.hpp"
 #include "io/nifti_io.hpp"
+#include "io/rtstruct.hpp"
 #include "io/scene_file.hpp"
 
 namespace vb::app {
@@ -45,15 +48,44 @@ void warn_implausible_moduli(const Scene& scene, const Lattice& lattice, std::ve
   }
 }
 
+/// model.structures rasterised on the CT: each ROI the table maps to a tissue gets a label value
+/// (1, 2, … in the file's order), which model.label_table maps to its tissue; names: value → ROI.
+ImageVolume structure_labels(ModelSpec& model, const ImageVolume& ct, std::map<int, std::string>& names) {
+  const StructureSet set = read_rtstruct(model.structures_path);
+  StructureLabelRule rule;
+  rule.priority = model.structure_priority;
+  for (const StructureRoi& roi : set.rois) {
+    const auto tissue = model.structure_table.find(roi.name);
+    if (tissue == model.structure_table.end()) continue;  // rasterise_structures names it
+    if (tissue->second == "ignore") {
+      rule.labels[roi.name] = 0;
+      continue;
+    }
+    const int value = int(names.size()) + 1;
+    rule.labels[roi.name] = value;
+    names[value] = roi.name;
+    model.label_table[value] = tissue->second;
+  }
+  for (const auto& [roi, tissue] : model.structure_table)
+    require(rule.labels.count(roi), "the structure table names ROI '" + roi + "', which the RTSTRUCT does not hold",
+            model.structures_path, "check the ROI names in the file");
+  return rasterise_structures(set, ct, rule);
+}
+
 }  // namespace
 
 PreparedModel prepare_model(const Scene& scene, const DeviceInfo* device) {
   PreparedModel m;
   if (scene.model.from_image()) {
     m.ct = load_ct(scene.model, m.warnings);
-    std::optional<ImageVolume> labels;
-    if (!scene.model.labels_path.empty()) labels = read_nifti(scene.model.labels_path);
-    const TissueMap map = classify_image(scene.model, *m.ct, labels ? &*labels : nullptr);
+    ModelSpec model = scene.model;
+    if (!model.labels_path.empty()) {
+      m.labels = read_nifti(model.labels_path);
+      m.label_names = model.label_table;
+    } else if (!model.structures_path.empty()) {
+      m.labels = structure_labels(model, *m.ct, m.label_names);
+    }
+    const TissueMap map = classify_image(model, *m.ct, m.labels ? &*m.labels : nullptr);
     m.lattice = build_lattice(lattice_volume_from_image(scene.model, *m.ct, map), scene.model.downsample);
   } else {
     m.lattice = build_lattice(voxelise_shapes(scene), scene.model.downsample);

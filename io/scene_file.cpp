@@ -75,6 +75,14 @@ std::map<int, std::string> read_label_table(const Section& s) {
   return table;
 }
 
+/// `[model.structure_table]`: ROI name → tissue name.
+std::map<std::string, std::string> read_structure_table(const Section& s) {
+  std::map<std::string, std::string> table;
+  for (const std::string& key : s.keys()) table[key] = s.required(key, s.text(key));
+  if (table.empty()) s.fail("", "the structure table is empty", "map ROI names to tissue names");
+  return table;
+}
+
 HuClass read_hu_class(const Section& s) {
   s.check_keys({"tissue", "min", "max"});
   HuClass c;
@@ -104,10 +112,18 @@ void read_image_model(const Section& s, ModelSpec& model) {
   model.labels_path = s.text("labels").value_or("");
   if (const auto table = s.table("label_table")) model.label_table = read_label_table(*table);
   for (const Section& c : s.tables("hu_class")) model.hu_classes.push_back(read_hu_class(c));
-  const bool by_labels = !model.labels_path.empty();
-  if (by_labels == !model.hu_classes.empty()) {
-    s.fail("image", "an image model needs exactly one of 'labels' (with [model.label_table]) or [[model.hu_class]]");
+  model.structures_path = s.text("structures").value_or("");
+  if (const auto table = s.table("structure_table")) model.structure_table = read_structure_table(*table);
+  model.structure_priority = s.strings("structure_priority").value_or(std::vector<std::string>{});
+  const bool by_labels = !model.labels_path.empty(), by_structures = !model.structures_path.empty();
+  if (int(by_labels) + int(by_structures) + int(!model.hu_classes.empty()) != 1) {
+    s.fail("image", "an image model needs exactly one of 'labels' (with [model.label_table]), 'structures' (with "
+                    "[model.structure_table]) or [[model.hu_class]]");
   }
+  if (by_structures && model.structure_table.empty())
+    s.fail("structures", "'structures' needs a [model.structure_table]");
+  if (!by_structures && (!model.structure_table.empty() || !model.structure_priority.empty()))
+    s.fail(model.structure_table.empty() ? "structure_priority" : "structure_table", "needs 'structures'");
   if (by_labels && model.label_table.empty()) s.fail("labels", "'labels' needs a [model.label_table]");
   if (!by_labels && !model.label_table.empty()) s.fail("label_table", "[model.label_table] needs 'labels'");
   model.keep = s.strings("keep").value_or(std::vector<std::string>{});
@@ -122,7 +138,7 @@ void read_image_model(const Section& s, ModelSpec& model) {
 
 ModelSpec read_model(const Section& s) {
   s.check_keys({"spacing", "downsample", "shape", "image", "series", "allow_gaps", "labels", "label_table",
-                "hu_class", "keep", "roi_min", "roi_max"});
+                "hu_class", "keep", "roi_min", "roi_max", "structures", "structure_table", "structure_priority"});
   ModelSpec model;
   model.line = s.line();
   model.downsample = s.integer<int>("downsample", 1).value_or(model.downsample);
@@ -132,7 +148,8 @@ ModelSpec read_model(const Section& s) {
     read_image_model(s, model);
     return model;
   }
-  for (const char* key : {"series", "allow_gaps", "labels", "label_table", "hu_class", "keep", "roi_min", "roi_max"}) {
+  for (const char* key : {"series", "allow_gaps", "labels", "label_table", "hu_class", "keep", "roi_min", "roi_max",
+                          "structures", "structure_table", "structure_priority"}) {
     if (s.find(key)) s.fail(key, "applies to image models only", "add model.image or remove it");
   }
   if (model.shapes.empty()) {
@@ -649,6 +666,8 @@ void check_labels(Scene& scene, const std::string& source) {
     resolve(scene.model.shapes[i].label, scene.model.shapes[i].line, "model.shape[" + std::to_string(i) + "].label");
   for (const auto& [value, tissue] : scene.model.label_table)
     resolve(tissue, scene.model.line, "model.label_table." + std::to_string(value));
+  for (const auto& [roi, tissue] : scene.model.structure_table)
+    if (tissue != "ignore") resolve(tissue, scene.model.line, "model.structure_table." + roi);
   for (std::size_t i = 0; i < scene.model.hu_classes.size(); ++i)
     resolve(scene.model.hu_classes[i].tissue, scene.model.hu_classes[i].line, "model.hu_class[" + std::to_string(i) + "].tissue");
 }
@@ -656,7 +675,7 @@ void check_labels(Scene& scene, const std::string& source) {
 /// Relative data paths in a scene file are relative to the scene file's folder.
 void resolve_paths(ModelSpec& model, const std::string& scene_path) {
   const std::filesystem::path base = std::filesystem::path(scene_path).parent_path();
-  for (std::string* p : {&model.image_path, &model.labels_path}) {
+  for (std::string* p : {&model.image_path, &model.labels_path, &model.structures_path}) {
     if (!p->empty() && std::filesystem::path(*p).is_relative()) *p = (base / *p).lexically_normal().string();
   }
 }
@@ -712,7 +731,7 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
 }
 
 const std::vector<std::string>& scene_path_keys() {
-  static const std::vector<std::string> keys = {"model.image", "model.labels"};  // as resolve_paths
+  static const std::vector<std::string> keys = {"model.image", "model.labels", "model.structures"};  // as resolve_paths
   return keys;
 }
 

@@ -12,6 +12,7 @@ packages=(
   libdcmtk-dev dcmtk libnifti2-dev python3-pydicom python3-nibabel clang libclang-rt-14-dev
   python3 python3-matplotlib python3-numpy python3-h5py python3-vtk9
   libopenmpi-dev openmpi-bin
+  dicom3tools plastimatch
 )
 
 missing=()

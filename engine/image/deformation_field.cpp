@@ -2,10 +2,13 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <cmath>
 #include <tuple>
 
 #include "engine/error.hpp"
+#include "engine/sim/parallel_chunks.hpp"
 
 namespace vb {
 
@@ -48,14 +51,22 @@ Eigen::Vector3d LatticeField::displacement_at(const Eigen::Vector3d& p) const {
   return weight > 0 ? Eigen::Vector3d(sum / weight) : Eigen::Vector3d::Zero();
 }
 
+void for_each_slice(const ImageVolume& grid, const std::function<void(int k)>& slice, const ImageProgress& progress) {
+  const std::size_t slices = std::size_t(std::max(0, grid.dims[2]));
+  for_each_index_dynamic(slices, [&](std::size_t k) { slice(int(k)); }, [&](std::size_t done) {
+    if (progress) progress(double(done) / double(slices));
+  });
+}
+
 namespace {
 
-/// Calls f(i, j, k, world centre) for every voxel of the grid.
+/// Calls f(i, j, k, world centre) for every voxel of the grid, slices on all cores.
 template <class F>
-void for_each_voxel(const ImageVolume& grid, F&& f) {
-  for (int k = 0; k < grid.dims[2]; ++k)
+void for_each_voxel(const ImageVolume& grid, F&& f, const ImageProgress& progress = {}) {
+  for_each_slice(grid, [&](int k) {
     for (int j = 0; j < grid.dims[1]; ++j)
       for (int i = 0; i < grid.dims[0]; ++i) f(i, j, k, grid.world_of_index(Eigen::Vector3d(i, j, k)));
+  }, progress);
 }
 
 /// Trilinear sample of the image at continuous index q; edge voxels extend outwards.
@@ -77,75 +88,151 @@ float sample(const ImageVolume& img, const Eigen::Vector3d& q) {
 
 }  // namespace
 
-std::vector<float> forward_displacement_on_grid(const LatticeField& field, const ImageVolume& grid) {
+std::vector<float> forward_displacement_on_grid(const LatticeField& field, const ImageVolume& grid,
+                                                const ImageProgress& progress) {
   std::vector<float> out(3 * grid.voxel_count(), 0.f);
   for_each_voxel(grid, [&](int i, int j, int k, const Eigen::Vector3d& p) {
     const Eigen::Vector3d u = field.displacement_at(p);
     const std::size_t v = grid.linear_index(i, j, k);
     for (int c = 0; c < 3; ++c) out[3 * v + c] = float(u[c]);
-  });
+  }, progress);
   return out;
 }
 
 namespace {
 
-/// Where tissue ends up: for each CT voxel, the displacement of an element whose displaced centre
-/// lies in it (the starting guesses for inverting x + u(x) = y near moved tissue).
-std::vector<std::int64_t> splat_elements(const ImageVolume& ct, const Lattice& lattice, const std::vector<double>& u) {
-  std::vector<std::int64_t> seed(ct.voxel_count(), -1);
+/// Where tissue ends up: for each CT voxel, an element whose displaced centre lies in it (the
+/// starting guesses for inverting x + u(x) = y near moved tissue), and for each block of
+/// `block` × `block` × `block` voxels whether any voxel of it holds one (so that a voxel with no
+/// seed within reach skips the search at once).
+struct Seeds {
+  std::vector<std::int64_t> element;  ///< per CT voxel, −1 where none landed
+  int block = 1;
+  std::array<int, 3> blocks{0, 0, 0};
+  std::vector<std::uint8_t> block_has_seed;
+
+  bool any_within(const ImageVolume& ct, int i, int j, int k, int reach) const {
+    const int lo[3] = {std::max(0, i - reach) / block, std::max(0, j - reach) / block, std::max(0, k - reach) / block};
+    const int hi[3] = {std::min(ct.dims[0] - 1, i + reach) / block, std::min(ct.dims[1] - 1, j + reach) / block,
+                       std::min(ct.dims[2] - 1, k + reach) / block};
+    for (int c = lo[2]; c <= hi[2]; ++c)
+      for (int b = lo[1]; b <= hi[1]; ++b)
+        for (int a = lo[0]; a <= hi[0]; ++a)
+          if (block_has_seed[std::size_t(a) + std::size_t(blocks[0]) * (std::size_t(b) + std::size_t(blocks[1]) * c)])
+            return true;
+    return false;
+  }
+};
+
+Seeds splat_elements(const ImageVolume& ct, const Lattice& lattice, const std::vector<double>& u, int reach) {
+  Seeds s;
+  s.element.assign(ct.voxel_count(), -1);
+  s.block = std::max(1, reach);
+  for (int a = 0; a < 3; ++a) s.blocks[a] = (ct.dims[a] + s.block - 1) / s.block;
+  s.block_has_seed.assign(std::size_t(s.blocks[0]) * s.blocks[1] * s.blocks[2], 0);
   const Eigen::Matrix4d to_index = ct.affine_lps_m.inverse();
   for (std::size_t e = 0; e < lattice.element_count(); ++e) {
     const Eigen::Vector3d y = lattice.rest_position(e) + Eigen::Vector3d(u[3 * e], u[3 * e + 1], u[3 * e + 2]);
     const Eigen::Vector3d q = (to_index * y.homogeneous()).head<3>();
     const int i = int(std::lround(q[0])), j = int(std::lround(q[1])), k = int(std::lround(q[2]));
     if (i < 0 || j < 0 || k < 0 || i >= ct.dims[0] || j >= ct.dims[1] || k >= ct.dims[2]) continue;
-    seed[ct.linear_index(i, j, k)] = std::int64_t(e);
+    s.element[ct.linear_index(i, j, k)] = std::int64_t(e);
+    s.block_has_seed[std::size_t(i / s.block) +
+                     std::size_t(s.blocks[0]) * (std::size_t(j / s.block) + std::size_t(s.blocks[1]) * (k / s.block))] = 1;
   }
-  return seed;
+  return s;
+}
+
+/// Voxel offsets within `reach` along each axis, nearest (in metres on the CT grid) first.
+std::vector<Eigen::Vector3i> offsets_nearest_first(const ImageVolume& ct, int reach) {
+  std::vector<Eigen::Vector3i> offsets;
+  for (int c = -reach; c <= reach; ++c)
+    for (int b = -reach; b <= reach; ++b)
+      for (int a = -reach; a <= reach; ++a) offsets.emplace_back(a, b, c);
+  const Eigen::Matrix3d axes = ct.affine_lps_m.topLeftCorner<3, 3>();
+  std::stable_sort(offsets.begin(), offsets.end(), [&](const Eigen::Vector3i& p, const Eigen::Vector3i& q) {
+    return (axes * p.cast<double>()).squaredNorm() < (axes * q.cast<double>()).squaredNorm();
+  });
+  return offsets;
 }
 
 }  // namespace
 
-WarpResult warp_image(const ImageVolume& ct, const Lattice& lattice, const std::vector<double>& u, int iterations) {
+WarpResult warp_image(const ImageVolume& ct, const Lattice& lattice, const std::vector<double>& u, int iterations,
+                      const ImageProgress& progress, const ImageVolume* labels) {
   const LatticeField field(lattice, u);
+  require(!labels || (labels->dims == ct.dims && labels->values.size() == ct.voxel_count()),
+          "the label map's grid is not the CT's");
   WarpResult r;
   r.warped = ct;
+  if (labels) r.warped_labels = *labels;
   r.inverse_field.assign(3 * ct.voxel_count(), 0.f);
   const Eigen::Matrix4d to_index = ct.affine_lps_m.inverse();
-  const std::vector<std::int64_t> seed = splat_elements(ct, lattice, u);
   const float background = *std::min_element(ct.values.begin(), ct.values.end());
   const double tolerance = 1e-3 * ct.spacing_m().minCoeff();
+  const double converged = 1e-3 * tolerance;  // iterations stop here; acceptance is at `tolerance`
   // Search radius for seeds: lattice elements can be sparser than CT voxels.
   const int reach = 1 + int(std::ceil(lattice.spacing_m / ct.spacing_m().minCoeff()));
-  // A tissue point x (inside the model) with x + u(x) = y, tried from y and from nearby seeds.
-  auto tissue_source = [&](const Eigen::Vector3d& y, Eigen::Vector3d x, Eigen::Vector3d& found) {
-    for (int it = 0; it < iterations; ++it) x = y - field.displacement_at(x);
-    const double residual = (x + field.displacement_at(x) - y).norm();
-    if (residual > tolerance || field.element_at(x) < 0) return false;
-    r.max_fixed_point_residual_m = std::max(r.max_fixed_point_residual_m, residual);
+  const Seeds seeds = splat_elements(ct, lattice, u, reach);
+  const std::vector<Eigen::Vector3i> offsets = offsets_nearest_first(ct, reach);
+  // A tissue point x (inside the model) with x + u(x) = y, iterated from x; its residual in `residual`.
+  auto tissue_source = [&](const Eigen::Vector3d& y, Eigen::Vector3d x, Eigen::Vector3d& found, double& residual) {
+    for (int it = 0;; ++it) {
+      const Eigen::Vector3d miss = x + field.displacement_at(x) - y;
+      residual = miss.norm();
+      if (residual <= converged || it == iterations) break;
+      x -= miss;
+    }
+    if (!(residual <= tolerance) || field.element_at(x) < 0) return false;
     found = x;
     return true;
   };
-  for_each_voxel(ct, [&](int i, int j, int k, const Eigen::Vector3d& y) {
-    const std::size_t v = ct.linear_index(i, j, k);
-    Eigen::Vector3d x;
-    bool found = tissue_source(y, y, x);
-    for (int dk = -reach; dk <= reach && !found; ++dk)
-      for (int dj = -reach; dj <= reach && !found; ++dj)
-        for (int di = -reach; di <= reach && !found; ++di) {
-          const int a = i + di, b = j + dj, c = k + dk;
-          if (a < 0 || b < 0 || c < 0 || a >= ct.dims[0] || b >= ct.dims[1] || c >= ct.dims[2]) continue;
-          const std::int64_t e = seed[ct.linear_index(a, b, c)];
-          if (e >= 0) found = tissue_source(y, y - Eigen::Vector3d(u[3 * e], u[3 * e + 1], u[3 * e + 2]), x);
-        }
-    if (found) {
-      r.warped.values[v] = sample(ct, (to_index * x.homogeneous()).head<3>());
-      for (int c = 0; c < 3; ++c) r.inverse_field[3 * v + c] = float(x[c] - y[c]);
-    } else if (field.element_at(y) >= 0) {  // tissue left this voxel and none arrived
-      r.warped.values[v] = background;
-      ++r.vacated_voxels;
-    }  // else: background that no tissue reaches keeps its value
-  });
+  std::vector<double> slice_residual(std::size_t(std::max(0, ct.dims[2])), 0.0);
+  std::vector<std::size_t> slice_vacated(slice_residual.size(), 0);
+  for_each_slice(ct, [&](int k) {
+    for (int j = 0; j < ct.dims[1]; ++j) {
+      bool previous_found = false;
+      Eigen::Vector3d previous_offset = Eigen::Vector3d::Zero();
+      for (int i = 0; i < ct.dims[0]; ++i) {
+        const Eigen::Vector3d y = ct.world_of_index(Eigen::Vector3d(i, j, k));
+        const std::size_t v = ct.linear_index(i, j, k);
+        Eigen::Vector3d x;
+        double residual = 0;
+        bool found = previous_found && tissue_source(y, y + previous_offset, x, residual);
+        if (!found) found = tissue_source(y, y, x, residual);
+        if (!found && seeds.any_within(ct, i, j, k, reach))
+          for (const Eigen::Vector3i& o : offsets) {
+            const int a = i + o[0], b = j + o[1], c = k + o[2];
+            if (a < 0 || b < 0 || c < 0 || a >= ct.dims[0] || b >= ct.dims[1] || c >= ct.dims[2]) continue;
+            const std::int64_t e = seeds.element[ct.linear_index(a, b, c)];
+            found = e >= 0 && tissue_source(y, y - Eigen::Vector3d(u[3 * e], u[3 * e + 1], u[3 * e + 2]), x, residual);
+            if (found) break;
+          }
+        previous_found = found;
+        if (found) {
+          previous_offset = x - y;
+          slice_residual[std::size_t(k)] = std::max(slice_residual[std::size_t(k)], residual);
+          const Eigen::Vector3d q = (to_index * x.homogeneous()).head<3>();
+          r.warped.values[v] = sample(ct, q);
+          if (labels) {
+            const int a = std::clamp(int(std::lround(q[0])), 0, ct.dims[0] - 1),
+                      b = std::clamp(int(std::lround(q[1])), 0, ct.dims[1] - 1),
+                      c = std::clamp(int(std::lround(q[2])), 0, ct.dims[2] - 1);
+            r.warped_labels.values[v] = labels->values[ct.linear_index(a, b, c)];
+          }
+          for (int c = 0; c < 3; ++c) r.inverse_field[3 * v + c] = float(x[c] - y[c]);
+        } else if (field.element_at(y) >= 0) {  // tissue left this voxel and none arrived
+          r.warped.values[v] = background;
+          if (labels) r.warped_labels.values[v] = 0;
+          ++slice_vacated[std::size_t(k)];
+        }  // else: background that no tissue reaches keeps its value
+      }
+    }
+  }, progress);
+  for (std::size_t k = 0; k < slice_residual.size(); ++k) {
+    r.max_fixed_point_residual_m = std::max(r.max_fixed_point_residual_m, slice_residual[k]);
+    r.vacated_voxels += slice_vacated[k];
+  }
   return r;
 }
 

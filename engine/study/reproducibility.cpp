@@ -52,7 +52,8 @@ std::optional<std::string> unsettled_runs_warning(const ReproducibilityResult& r
 
 ReproducibilityResult run_reproducibility(const Scene& scene, const Lattice& lattice, const ClContext& cl,
                                           const std::vector<double>* rest_offsets_m,
-                                          const std::function<void(const PerturbedRun&)>& on_run) {
+                                          const std::function<void(const PerturbedRun&)>& on_run,
+                                          const std::function<void(const RunProgress&)>& on_step) {
   const std::string where = "reproducibility (line " + std::to_string(scene.reproducibility.line) + ")";
   const AnchorSpec* wall = chest_wall_anchor(scene);
   require(wall && wall->kind == AnchorSpec::Kind::Sphere, "the chest wall to perturb is not a sphere anchor", where,
@@ -78,7 +79,7 @@ ReproducibilityResult run_reproducibility(const Scene& scene, const Lattice& lat
       const ElementArrays el = make_element_arrays(posed, lattice);  // the held elements' new pose
       sim.upload(el.displacement_m, at_rest);  // the patient turned with the chest wall
       sim.restart_clock();
-      const RunOutput run = run_simulation(posed, lattice, el, sim);
+      const RunOutput run = run_simulation(posed, lattice, el, sim, on_step);
       const PositioningMetrics m = compute_positioning_metrics(posed, lattice, el, run.summary, run.state);
       require(m.tumour.has_value(), "the scene has no tumour tissue to follow", where,
               "set [positioning] tumour_tissue to the tissue to follow");
