@@ -13,6 +13,7 @@
 #include "io/nifti_io.hpp"
 #include "io/rtstruct.hpp"
 #include "io/scene_file.hpp"
+#include "io/scene_structures.hpp"
 
 namespace vb::app {
 
@@ -50,13 +51,14 @@ void warn_implausible_moduli(const Scene& scene, const Lattice& lattice, std::ve
 
 /// model.structures rasterised on the CT: each ROI the table maps to a tissue gets a label value
 /// (1, 2, … in the file's order), which model.label_table maps to its tissue; names: value → ROI.
-ImageVolume structure_labels(ModelSpec& model, const ImageVolume& ct, std::map<int, std::string>& names) {
-  const StructureSet set = read_rtstruct(model.structures_path);
+ImageVolume structure_labels(const StructureSpec& structures, const ImageVolume& ct, ModelSpec& model,
+                             std::map<int, std::string>& names) {
+  const StructureSet set = read_rtstruct(structures.path);
   StructureLabelRule rule;
-  rule.priority = model.structure_priority;
+  rule.priority = structures.priority;
   for (const StructureRoi& roi : set.rois) {
-    const auto tissue = model.structure_table.find(roi.name);
-    if (tissue == model.structure_table.end()) continue;  // rasterise_structures names it
+    const auto tissue = structures.table.find(roi.name);
+    if (tissue == structures.table.end()) continue;  // rasterise_structures names it
     if (tissue->second == "ignore") {
       rule.labels[roi.name] = 0;
       continue;
@@ -66,9 +68,9 @@ ImageVolume structure_labels(ModelSpec& model, const ImageVolume& ct, std::map<i
     names[value] = roi.name;
     model.label_table[value] = tissue->second;
   }
-  for (const auto& [roi, tissue] : model.structure_table)
+  for (const auto& [roi, tissue] : structures.table)
     require(rule.labels.count(roi), "the structure table names ROI '" + roi + "', which the RTSTRUCT does not hold",
-            model.structures_path, "check the ROI names in the file");
+            structures.path, "check the ROI names in the file");
   return rasterise_structures(set, ct, rule);
 }
 
@@ -82,8 +84,8 @@ PreparedModel prepare_model(const Scene& scene, const DeviceInfo* device) {
     if (!model.labels_path.empty()) {
       m.labels = read_nifti(model.labels_path);
       m.label_names = model.label_table;
-    } else if (!model.structures_path.empty()) {
-      m.labels = structure_labels(model, *m.ct, m.label_names);
+    } else if (const StructureSpec structures = scene_structures(scene); !structures.path.empty()) {
+      m.labels = structure_labels(structures, *m.ct, model, m.label_names);
     }
     const TissueMap map = classify_image(model, *m.ct, m.labels ? &*m.labels : nullptr);
     m.lattice = build_lattice(lattice_volume_from_image(scene.model, *m.ct, map), scene.model.downsample);

@@ -15,8 +15,8 @@ namespace vb {
 namespace {
 
 /// Payload bytes per block: large enough that a fresh deflate dictionary per block costs little
-/// ratio, small enough that the blocks in flight (two per core) stay a few tens of MB.
-constexpr std::size_t kBlockBytes = std::size_t(4) << 20;
+/// ratio, small enough that the blocks in flight (one per core) stay a few MB.
+constexpr std::size_t kBlockBytes = std::size_t(2) << 20;
 
 struct Block {
   std::vector<unsigned char> raw, packed;
@@ -52,7 +52,7 @@ bool write_blocks(std::FILE* file, const std::string& prefix, std::size_t payloa
                   bool gzip, int level) {
   const std::size_t total = prefix.size() + payload_bytes;
   const std::size_t block_count = std::max<std::size_t>(1, (total + kBlockBytes - 1) / kBlockBytes);
-  const std::size_t in_flight = 2 * chunk_count(block_count, 1);
+  const std::size_t in_flight = chunk_count(block_count, 1);
   std::vector<Block> blocks(std::min(in_flight, block_count));
   bool ok = true;
   if (gzip) {

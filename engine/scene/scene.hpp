@@ -45,9 +45,6 @@ struct ModelSpec {
   std::string labels_path;  ///< label volume (NIfTI) on the CT grid
   std::map<int, std::string> label_table;  ///< label value → tissue name
   std::vector<HuClass> hu_classes;         ///< alternative to a label volume
-  std::string structures_path;             ///< RTSTRUCT on the CT: another alternative to a label volume
-  std::map<std::string, std::string> structure_table;  ///< ROI name → tissue name ("ignore": left out)
-  std::vector<std::string> structure_priority;         ///< overlapping ROIs: these ROI names, first wins
   std::vector<std::string> keep;           ///< tissues to build (empty: all classified tissues)
   std::optional<std::pair<Vec3, Vec3>> roi_m;  ///< world box (min, max) the model is cropped to
   int line = 0;
