@@ -163,6 +163,8 @@ void write_rtstruct(const std::string& path, const StructureSet& set, const std:
   put(rt.setStudyTime(ct.patient_study.at(DCM_StudyTime).c_str()), "StudyTime");
   put(rt.setReferringPhysicianName(ct.patient_study.at(DCM_ReferringPhysicianName).c_str()), "ReferringPhysicianName");
   put(rt.setStudyID(ct.patient_study.at(DCM_StudyID).c_str()), "StudyID");
+  put(rt.setFrameOfReferenceUID(ct.frame_uid.c_str()), "FrameOfReferenceUID");  // the Frame of Reference module
+  put(rt.setPositionReferenceIndicator(""), "PositionReferenceIndicator");
   put(rt.setAccessionNumber(ct.patient_study.at(DCM_AccessionNumber).c_str()), "AccessionNumber");
   put(rt.setModality("RTSTRUCT"), "Modality");
   put(rt.setSeriesInstanceUID(new_uid(SITE_SERIES_UID_ROOT).c_str()), "SeriesInstanceUID");

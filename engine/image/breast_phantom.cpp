@@ -257,7 +257,7 @@ ImageVolume make_grid(const PhantomSpec& spec, std::string modality) {
   const double voxels = double(vol.dims[0]) * vol.dims[1] * vol.dims[2];
   require(voxels <= kMaxVoxels, "the phantom would have " + std::to_string(long(voxels)) + " voxels",
           "phantom.spacing_m", "increase the spacing or shrink the field of view");
-  vol.affine_lps_m.topLeftCorner<3, 3>() = h_m.asDiagonal();
+  vol.affine_lps_m.topLeftCorner<3, 3>() = Eigen::Matrix3d(h_m.asDiagonal());
   vol.affine_lps_m.topRightCorner<3, 1>() = -h_m.cwiseProduct(Eigen::Vector3d(low[0], low[1], low[2]));
   vol.values.assign(vol.voxel_count(), 0.0f);
   vol.modality = std::move(modality);
@@ -294,7 +294,7 @@ bool is_soft_tissue(float label) {
 /// Integer offsets within the ellipsoid of semi-axes radius_vox (in voxels along i, j, k) of the
 /// origin (the origin included).
 std::vector<Eigen::Vector3i> ball_offsets(const Eigen::Vector3d& radius_vox) {
-  const Eigen::Vector3i reach = (radius_vox.array() + 1e-9).floor().cast<int>();
+  const Eigen::Vector3i reach = (radius_vox.array() + 1e-9).floor().cast<int>().matrix();
   std::vector<Eigen::Vector3i> offsets;
   for (int c = -reach.z(); c <= reach.z(); ++c)
     for (int b = -reach.y(); b <= reach.y(); ++b)
