@@ -132,17 +132,7 @@ nlohmann::json run_job_bench(const ClContext& cl, const BenchOptions& o) {
     const OutputDir job_dir(dir);
     SimulationOptions options;
     options.command_start = command_start;
-    double tolerance = scene.stop.equilibrium;
-    options.on_phase = [&](const std::string& phase) {
-      bar.phase("job " + std::to_string(n + 1) + " " + phase);
-      tolerance = phase == "reference state" ? reference_state_scene(scene).stop.equilibrium : scene.stop.equilibrium;
-    };
-    options.on_progress = [&](const RunProgress& p) {
-      const std::string text = "step " + std::to_string(p.step);
-      if (tolerance > 0) bar.converge(p.residual, tolerance, text);
-      else bar.update(double(p.step) / double(p.max_steps), text);
-    };
-    options.on_image_progress = [&](const std::string& what, double fraction) { bar.update(fraction, what); };
+    show_progress(bar, scene, options, "job " + std::to_string(n + 1) + " ");
     const SimulationReport report = simulate_scene(scene, cl, dir, options);
     bar.finish();
     const nlohmann::json summary = nlohmann::json::parse(std::ifstream(dir + "/summary.json"));

@@ -28,26 +28,7 @@ int run_simulate(const SimulateOptions& o) {
   Progress bar(!o.quiet, o.status_interval_s);
   SimulationOptions options;
   options.command_start = command_start;
-  // Each run ends at its equilibrium tolerance: the reference state's solves at their own.
-  double tolerance = scene.stop.equilibrium;
-  options.on_phase = [&](const std::string& phase) {
-    bar.phase(phase);
-    tolerance = phase == "reference state" ? reference_state_scene(scene).stop.equilibrium : scene.stop.equilibrium;
-  };
-  options.on_start = [&](const PreparedModel& model, const Simulator& sim) {
-    if (!o.quiet)
-      std::fprintf(stderr, "voxbreast: %zu elements, %zu connections, dt = %.3g s (%s), device %s, %s\n",
-                   model.lattice.element_count(), model.lattice.connection_count, sim.dt_s(),
-                   sim.time_step().automatic ? "auto" : "given", cl.info.name.c_str(),
-                   scene.solver.precision == Precision::Double ? "double" : "float");
-  };
-  options.on_progress = [&](const RunProgress& p) {
-    char text[160];
-    std::snprintf(text, sizeof text, "step %lld  t=%.4g s  speed %.2e", (long long)p.step, p.time_s, p.speed_ratio);
-    if (tolerance > 0) bar.converge(p.residual, tolerance, text);
-    else bar.update(double(p.step) / double(p.max_steps), text);  // no equilibrium rule: the step limit ends the run
-  };
-  options.on_image_progress = [&](const std::string& what, double fraction) { bar.update(fraction, what); };
+  show_progress(bar, scene, options);
   options.on_reference_iteration = [&](const ReferenceIteration& r) {
     if (o.quiet) return;
     bar.phase("reference state");

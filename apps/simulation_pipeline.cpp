@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <mutex>
 #include <optional>
 
@@ -9,6 +10,7 @@
 #include "engine/error.hpp"
 #include "apps/image_outputs.hpp"
 #include "apps/mesh_outputs.hpp"
+#include "apps/progress.hpp"
 #include "io/atomic_file.hpp"
 #include "io/csv_table.hpp"
 #include "io/dicom_io.hpp"
@@ -41,6 +43,22 @@ void write_reproducibility_csv(const std::string& path, const ReproducibilityRes
 }
 
 }  // namespace
+
+void show_progress(Progress& bar, const Scene& scene, SimulationOptions& options, const std::string& prefix) {
+  // Each run ends at its equilibrium tolerance: the reference state's solves at their own.
+  auto tolerance = std::make_shared<double>(scene.stop.equilibrium);
+  options.on_phase = [&bar, &scene, tolerance, prefix](const std::string& phase) {
+    bar.phase(prefix + phase);
+    *tolerance = phase == "reference state" ? reference_state_scene(scene).stop.equilibrium : scene.stop.equilibrium;
+  };
+  options.on_progress = [&bar, tolerance](const RunProgress& p) {
+    char text[160];
+    std::snprintf(text, sizeof text, "step %lld  t=%.4g s  speed %.2e", (long long)p.step, p.time_s, p.speed_ratio);
+    if (*tolerance > 0) bar.converge(p.residual, *tolerance, text);
+    else bar.update(double(p.step) / double(p.max_steps), text);  // no equilibrium rule: the step limit ends the run
+  };
+  options.on_image_progress = [&bar](const std::string& what, double fraction) { bar.update(fraction, what); };
+}
 
 SimulationReport simulate_scene(const Scene& scene, const ClContext& cl, const std::string& out_dir,
                                 const SimulationOptions& options) {

@@ -57,6 +57,13 @@ struct SimulationReport {
   PhaseTimings timings;
 };
 
+class Progress;
+
+/// Shows the run on `bar`: each phase by name (after `prefix`), each run's residual against the
+/// equilibrium tolerance it stops at (the step count where the scene has none), the image outputs
+/// by the fraction done. Sets on_phase, on_progress and on_image_progress.
+void show_progress(Progress& bar, const Scene& scene, SimulationOptions& options, const std::string& prefix = "");
+
 /// Builds the scene's model, runs it on `cl` and writes the outputs into `out_dir` (which must
 /// exist), summary.json last. Safe to call from several threads at once, each with its own
 /// context: the file readers and writers that are not thread-safe (HDF5, DCMTK) take turns.

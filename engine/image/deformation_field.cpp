@@ -101,60 +101,69 @@ std::vector<float> forward_displacement_on_grid(const LatticeField& field, const
 
 namespace {
 
-/// Where tissue ends up: for each CT voxel, an element whose displaced centre lies in it (the
-/// starting guesses for inverting x + u(x) = y near moved tissue), and for each block of
-/// `block` × `block` × `block` voxels whether any voxel of it holds one (so that a voxel with no
-/// seed within reach skips the search at once).
-struct Seeds {
-  std::vector<std::int64_t> element;  ///< per CT voxel, −1 where none landed
-  int block = 1;
-  std::array<int, 3> blocks{0, 0, 0};
-  std::vector<std::uint8_t> block_has_seed;
+/// Where tissue ends up: the elements by the CT voxel their displaced centre lies in (the
+/// starting guesses for inverting x + u(x) = y near moved tissue), kept per block of `block`³
+/// voxels (a few bytes per element, nothing per voxel).
+class Seeds {
+ public:
+  Seeds(const ImageVolume& ct, const Lattice& lattice, const std::vector<double>& u, int reach)
+      : ct_(ct), reach_(reach), block_(std::max(1, reach)) {
+    for (int a = 0; a < 3; ++a) blocks_[a] = (ct.dims[a] + block_ - 1) / block_;
+    const Eigen::Matrix4d to_index = ct.affine_lps_m.inverse();
+    std::vector<std::pair<std::size_t, Entry>> placed;  // (block, entry)
+    for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+      const Eigen::Vector3d y = lattice.rest_position(e) + Eigen::Vector3d(u[3 * e], u[3 * e + 1], u[3 * e + 2]);
+      const Eigen::Vector3d q = (to_index * y.homogeneous()).head<3>();
+      const int i = int(std::lround(q[0])), j = int(std::lround(q[1])), k = int(std::lround(q[2]));
+      if (i < 0 || j < 0 || k < 0 || i >= ct.dims[0] || j >= ct.dims[1] || k >= ct.dims[2]) continue;
+      placed.push_back({block_of(i / block_, j / block_, k / block_), Entry{{i, j, k}, std::int64_t(e)}});
+    }
+    std::stable_sort(placed.begin(), placed.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
+    start_.assign(std::size_t(blocks_[0]) * blocks_[1] * blocks_[2] + 1, 0);
+    for (const auto& [block, entry] : placed) ++start_[block + 1];
+    for (std::size_t b = 1; b < start_.size(); ++b) start_[b] += start_[b - 1];
+    for (const auto& [block, entry] : placed) entries_.push_back(entry);
+  }
 
-  bool any_within(const ImageVolume& ct, int i, int j, int k, int reach) const {
-    const int lo[3] = {std::max(0, i - reach) / block, std::max(0, j - reach) / block, std::max(0, k - reach) / block};
-    const int hi[3] = {std::min(ct.dims[0] - 1, i + reach) / block, std::min(ct.dims[1] - 1, j + reach) / block,
-                       std::min(ct.dims[2] - 1, k + reach) / block};
+  /// The elements that landed within `reach` voxels of (i, j, k) along each axis, nearest (in
+  /// metres) first, ties in element order; `out` is reused.
+  void near(int i, int j, int k, std::vector<std::pair<double, std::int64_t>>& out) const {
+    out.clear();
+    const Eigen::Matrix3d axes = ct_.affine_lps_m.topLeftCorner<3, 3>();
+    const int at[3] = {i, j, k};
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(0, at[a] - reach_) / block_;
+      hi[a] = std::min(ct_.dims[a] - 1, at[a] + reach_) / block_;
+    }
     for (int c = lo[2]; c <= hi[2]; ++c)
       for (int b = lo[1]; b <= hi[1]; ++b)
-        for (int a = lo[0]; a <= hi[0]; ++a)
-          if (block_has_seed[std::size_t(a) + std::size_t(blocks[0]) * (std::size_t(b) + std::size_t(blocks[1]) * c)])
-            return true;
-    return false;
+        for (int a = lo[0]; a <= hi[0]; ++a) {
+          const std::size_t block = block_of(a, b, c);
+          for (std::size_t n = start_[block]; n < start_[block + 1]; ++n) {
+            const Entry& s = entries_[n];
+            const Eigen::Vector3i d(s.voxel[0] - i, s.voxel[1] - j, s.voxel[2] - k);
+            if (d.cwiseAbs().maxCoeff() > reach_) continue;
+            out.emplace_back((axes * d.cast<double>()).squaredNorm(), s.element);
+          }
+        }
+    std::sort(out.begin(), out.end());
   }
+
+ private:
+  struct Entry {
+    std::array<int, 3> voxel;
+    std::int64_t element;
+  };
+  std::size_t block_of(int a, int b, int c) const {
+    return std::size_t(a) + std::size_t(blocks_[0]) * (std::size_t(b) + std::size_t(blocks_[1]) * std::size_t(c));
+  }
+  const ImageVolume& ct_;
+  int reach_, block_;
+  std::array<int, 3> blocks_{0, 0, 0};
+  std::vector<std::size_t> start_;  ///< per block, its first entry; one past the end last
+  std::vector<Entry> entries_;
 };
-
-Seeds splat_elements(const ImageVolume& ct, const Lattice& lattice, const std::vector<double>& u, int reach) {
-  Seeds s;
-  s.element.assign(ct.voxel_count(), -1);
-  s.block = std::max(1, reach);
-  for (int a = 0; a < 3; ++a) s.blocks[a] = (ct.dims[a] + s.block - 1) / s.block;
-  s.block_has_seed.assign(std::size_t(s.blocks[0]) * s.blocks[1] * s.blocks[2], 0);
-  const Eigen::Matrix4d to_index = ct.affine_lps_m.inverse();
-  for (std::size_t e = 0; e < lattice.element_count(); ++e) {
-    const Eigen::Vector3d y = lattice.rest_position(e) + Eigen::Vector3d(u[3 * e], u[3 * e + 1], u[3 * e + 2]);
-    const Eigen::Vector3d q = (to_index * y.homogeneous()).head<3>();
-    const int i = int(std::lround(q[0])), j = int(std::lround(q[1])), k = int(std::lround(q[2]));
-    if (i < 0 || j < 0 || k < 0 || i >= ct.dims[0] || j >= ct.dims[1] || k >= ct.dims[2]) continue;
-    s.element[ct.linear_index(i, j, k)] = std::int64_t(e);
-    s.block_has_seed[std::size_t(i / s.block) +
-                     std::size_t(s.blocks[0]) * (std::size_t(j / s.block) + std::size_t(s.blocks[1]) * (k / s.block))] = 1;
-  }
-  return s;
-}
-
-/// Voxel offsets within `reach` along each axis, nearest (in metres on the CT grid) first.
-std::vector<Eigen::Vector3i> offsets_nearest_first(const ImageVolume& ct, int reach) {
-  std::vector<Eigen::Vector3i> offsets;
-  for (int c = -reach; c <= reach; ++c)
-    for (int b = -reach; b <= reach; ++b)
-      for (int a = -reach; a <= reach; ++a) offsets.emplace_back(a, b, c);
-  const Eigen::Matrix3d axes = ct.affine_lps_m.topLeftCorner<3, 3>();
-  std::stable_sort(offsets.begin(), offsets.end(), [&](const Eigen::Vector3i& p, const Eigen::Vector3i& q) {
-    return (axes * p.cast<double>()).squaredNorm() < (axes * q.cast<double>()).squaredNorm();
-  });
-  return offsets;
-}
 
 }  // namespace
 
@@ -173,8 +182,7 @@ WarpResult warp_image(const ImageVolume& ct, const Lattice& lattice, const std::
   const double converged = 1e-3 * tolerance;  // iterations stop here; acceptance is at `tolerance`
   // Search radius for seeds: lattice elements can be sparser than CT voxels.
   const int reach = 1 + int(std::ceil(lattice.spacing_m / ct.spacing_m().minCoeff()));
-  const Seeds seeds = splat_elements(ct, lattice, u, reach);
-  const std::vector<Eigen::Vector3i> offsets = offsets_nearest_first(ct, reach);
+  const Seeds seeds(ct, lattice, u, reach);
   // A tissue point x (inside the model) with x + u(x) = y, iterated from x; its residual in `residual`.
   auto tissue_source = [&](const Eigen::Vector3d& y, Eigen::Vector3d x, Eigen::Vector3d& found, double& residual) {
     for (int it = 0;; ++it) {
@@ -190,6 +198,7 @@ WarpResult warp_image(const ImageVolume& ct, const Lattice& lattice, const std::
   std::vector<double> slice_residual(std::size_t(std::max(0, ct.dims[2])), 0.0);
   std::vector<std::size_t> slice_vacated(slice_residual.size(), 0);
   for_each_slice(ct, [&](int k) {
+    std::vector<std::pair<double, std::int64_t>> candidates;
     for (int j = 0; j < ct.dims[1]; ++j) {
       bool previous_found = false;
       Eigen::Vector3d previous_offset = Eigen::Vector3d::Zero();
@@ -200,14 +209,13 @@ WarpResult warp_image(const ImageVolume& ct, const Lattice& lattice, const std::
         double residual = 0;
         bool found = previous_found && tissue_source(y, y + previous_offset, x, residual);
         if (!found) found = tissue_source(y, y, x, residual);
-        if (!found && seeds.any_within(ct, i, j, k, reach))
-          for (const Eigen::Vector3i& o : offsets) {
-            const int a = i + o[0], b = j + o[1], c = k + o[2];
-            if (a < 0 || b < 0 || c < 0 || a >= ct.dims[0] || b >= ct.dims[1] || c >= ct.dims[2]) continue;
-            const std::int64_t e = seeds.element[ct.linear_index(a, b, c)];
-            found = e >= 0 && tissue_source(y, y - Eigen::Vector3d(u[3 * e], u[3 * e + 1], u[3 * e + 2]), x, residual);
+        if (!found) {
+          seeds.near(i, j, k, candidates);
+          for (const auto& [distance, e] : candidates) {
+            found = tissue_source(y, y - Eigen::Vector3d(u[3 * e], u[3 * e + 1], u[3 * e + 2]), x, residual);
             if (found) break;
           }
+        }
         previous_found = found;
         if (found) {
           previous_offset = x - y;
