@@ -156,9 +156,10 @@ std::vector<Vec3> indenters_at(const Scene& scene, const Simulator& sim, double 
 
 }  // namespace
 
-void check_contact_before_run(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const Simulator& sim) {
+void check_contact_before_run(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const Simulator& sim,
+                              bool refuse_penetrating_start) {
   check_obstacle_speeds(scene, lattice.spacing_m, sim.dt_s());
-  if (sim.steps() > 0 || (scene.indenters.empty() && scene.tori.empty())) return;
+  if (!refuse_penetrating_start || sim.steps() > 0 || (scene.indenters.empty() && scene.tori.empty())) return;
   check_obstacles_start_outside(scene, lattice, positions_now(lattice, sim), el.inverse_mass,
                                 indenters_at(scene, sim, 0.0));
 }

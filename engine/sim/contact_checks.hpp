@@ -52,9 +52,12 @@ std::optional<std::string> indenter_in_held_tissue(const Scene& scene, const Lat
 
 class Simulator;
 
-/// Before a run's first step: the speeds (check_obstacle_speeds) and the start
-/// (check_obstacles_start_outside) of the scene's indenters and tori, for the simulator's state.
-void check_contact_before_run(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const Simulator& sim);
+/// Before a run's first step: the speeds (check_obstacle_speeds) and, with
+/// `refuse_penetrating_start`, the start (check_obstacles_start_outside) of the scene's indenters
+/// and tori, for the simulator's state. A run that starts overlapping a device on purpose (the
+/// reproducibility study turns the patient under a fixed device) passes false.
+void check_contact_before_run(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const Simulator& sim,
+                              bool refuse_penetrating_start = true);
 
 /// Throws indenter_in_held_tissue's description for the simulator's time, if any: the cause of a
 /// run that blew up or crushed elements, rather than its time step.

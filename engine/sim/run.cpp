@@ -159,7 +159,7 @@ std::size_t nearest_element(const Lattice& lattice, const Vec3& p) {
 }
 
 RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const ElementArrays& el, Simulator& sim,
-                         const std::function<void(const RunProgress&)>& progress) {
+                         const std::function<void(const RunProgress&)>& progress, bool refuse_penetrating_start) {
   require_anchored(scene, lattice, el);  // a free part under gravity never settles
   const auto start = std::chrono::steady_clock::now();
   const EquilibriumScales scales = equilibrium_scales(lattice, el);
@@ -171,7 +171,7 @@ RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const Eleme
     if (!ind.path.empty()) travel_end = std::max(travel_end, ind.path.back().time_s);
   }
   for (const TorusSpec& t : scene.tori) travel_end = std::max(travel_end, torus_inflation_end_s(t));
-  check_contact_before_run(scene, lattice, el, sim);
+  check_contact_before_run(scene, lattice, el, sim, refuse_penetrating_start);
   const std::int64_t check_every = std::max(1, scene.solver.check_every);
   const std::int64_t frames_every = scene.output.frames_every;
   std::int64_t max_steps = scene.stop.max_steps;

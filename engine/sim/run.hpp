@@ -26,7 +26,8 @@ struct RunOutput {
 /// Runs to a stopping rule. Throws vb::Error (with step, element and a smaller-dt hint) when the
 /// state stops being finite or an element moves more than half a spacing in one step.
 RunOutput run_simulation(const Scene& scene, const Lattice& lattice, const ElementArrays& elements,
-                         Simulator& sim, const std::function<void(const RunProgress&)>& progress = {});
+                         Simulator& sim, const std::function<void(const RunProgress&)>& progress = {},
+                         bool refuse_penetrating_start = true);
 
 /// Model-wide scales (docs/SCENE.md, "Equilibrium criterion"). The residual and speed tests scale
 /// each element by its own tissue on the device (StateCheck's ratios); these are the stiffest free

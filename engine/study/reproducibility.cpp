@@ -78,7 +78,9 @@ ReproducibilityResult run_reproducibility(const Scene& scene, const Lattice& lat
       const ElementArrays el = make_element_arrays(posed, lattice);  // the held elements' new pose
       sim.upload(el.displacement_m, at_rest);  // the patient turned with the chest wall
       sim.restart_clock();
-      const RunOutput run = run_simulation(posed, lattice, el, sim);
+      // The patient turns under the fixed device, so the rings may start in the skin: the first
+      // steps push it out, which is the device holding the breast.
+      const RunOutput run = run_simulation(posed, lattice, el, sim, {}, /*refuse_penetrating_start=*/false);
       const PositioningMetrics m = compute_positioning_metrics(posed, lattice, el, run.summary, run.state);
       require(m.tumour.has_value(), "the scene has no tumour tissue to follow", where,
               "set [positioning] tumour_tissue to the tissue to follow");
