@@ -250,7 +250,7 @@ void require_intact_gzip(const std::string& file, const std::string& path) {
   inflateEnd(&z);
   require(member_ended,
           status == Z_DATA_ERROR ? "corrupt gzip stream (" + reason + ")"
-                                 : std::string("corrupt gzip stream: it ends before its trailer"),
+                                 : std::string("corrupt gzip stream: it is truncated, ending before its trailer"),
           path, kCorruptFileHint);
 }
 

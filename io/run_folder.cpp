@@ -75,9 +75,10 @@ bool recorded(const Runs& runs, const std::string& entry) {
 
 bool starts_with(const std::string& s, const std::string& prefix) { return s.rfind(prefix, 0) == 0; }
 
-/// Left by a run that died here: its staging folder, entries moved aside, temporary files.
+/// Left by a run that died here: its staging folder, entries moved aside, temporary files, the
+/// probe that tests the folder is writable (io/atomic_file.cpp).
 bool is_leftover(const std::string& name) {
-  return starts_with(name, kStagingPrefix) || starts_with(name, kAsidePrefix) ||
+  return starts_with(name, kStagingPrefix) || starts_with(name, kAsidePrefix) || starts_with(name, ".write-probe-") ||
          (name.size() > 1 && name[0] == '.' && name.find(".tmp-") != std::string::npos);
 }
 

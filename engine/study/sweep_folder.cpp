@@ -96,10 +96,14 @@ std::vector<std::string> SweepFolder::open(const nlohmann::json& definition) con
       if (fs::exists(fs::symlink_status(path(name), ec)))
         throw Error(std::string("the output folder holds '") + name + "', which is not a VoxBreast sweep's (no sweep.json)",
                     dir_, "move it away or choose another --out");
+    // Another rank or worker of this sweep may already be writing its first case (in its
+    // work folder .NNNN.work-…) before sweep.json lands: that name is the sweep's own.
+    static const std::regex own_case(R"(\.[0-9]+\.work-.*)");
     for (const fs::directory_entry& e : fs::directory_iterator(path("cases"), ec))
-      throw Error("the output folder's cases/ holds '" + e.path().filename().string() +
-                      "', which is not a VoxBreast sweep's (no sweep.json)",
-                  dir_, "move it away or choose another --out");
+      if (!std::regex_match(e.path().filename().string(), own_case))
+        throw Error("the output folder's cases/ holds '" + e.path().filename().string() +
+                        "', which is not a VoxBreast sweep's (no sweep.json)",
+                    dir_, "move it away or choose another --out");
     write_text_atomically(file, record.dump(2) + "\n");
     return {};
   }

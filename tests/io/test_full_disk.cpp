@@ -13,6 +13,7 @@
 #include <functional>
 #include <cstdlib>
 #include <filesystem>
+#include <random>
 #include <string>
 
 #include "engine/error.hpp"
@@ -67,7 +68,10 @@ class FullDisk : public ::testing::Test {
     v.dims = {64, 64, 16};
     v.affine_lps_m.topLeftCorner<3, 3>() = 1e-3 * Eigen::Matrix3d::Identity();
     v.values.resize(v.voxel_count());
-    for (std::size_t i = 0; i < v.values.size(); ++i) v.values[i] = float((i * 2654435761u) % 2000) - 1000.0f;
+    // Random floats, so that the .nii.gz too stays far larger than the 64 KiB disk.
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> hu(-1000.0f, 1000.0f);
+    for (float& value : v.values) value = hu(random);
     v.modality = "CT";
     return v;
   }

@@ -149,7 +149,7 @@ TEST(SourceSlices, ThePulledBackPointsSlicesAreListed) {
   grid.affine_lps_m.topLeftCorner<3, 3>() = Eigen::Vector3d(1e-3, 1e-3, 2e-3).asDiagonal();
   std::vector<float> d(3 * grid.voxel_count(), 0.f);
   d[3 * grid.linear_index(1, 0, 1) + 2] = 3e-3f;   // slice 1 reads k = 2.5: slices 2 and 3
-  d[3 * grid.linear_index(0, 0, 4) + 2] = -2e-3f;  // slice 4 reads k = 3 exactly, and itself
+  d[3 * grid.linear_index(0, 0, 4) + 2] = -1.9e-3f;  // slice 4 reads k = 3.05: slices 3 and 4
   d[3 * grid.linear_index(0, 0, 0) + 2] = -5e-3f;  // slice 0 reads outside: clamped to slice 0
   const auto slices = source_slices_read(grid, d);
   ASSERT_EQ(slices.size(), 5u);

@@ -176,7 +176,7 @@ TEST(Instability, UnanchoredModelOrIslandUnderGravityIsRefusedBeforeTheRun) {
 }
 
 TEST(Instability, WithinTheStableStepATooSoftTissueIsNamedNotTheStep) {
-  Scene s = hanging_block(0, Integrator::Heun, 1e-6);
+  Scene s = hanging_block(0, Integrator::Relaxation, 1e-6);  // the dynamic integrators find no stable step at E = 1e-30
   s.materials["soft"].youngs_modulus_pa = 1e-30;
   try {
     run(s);
@@ -201,7 +201,7 @@ TEST(Instability, UnanchoredPartPushedByAnIndenterIsNamedNotTheStep) {
   plate.kind = IndenterSpec::Kind::Plate;
   plate.start_m = Vec3(0, 0, 10 * kH);
   plate.normal = Vec3(0, 0, -1);
-  plate.velocity_m_s = Vec3(0, 0, -2);
+  plate.velocity_m_s = Vec3(0, 0, -0.4);  // within the contact speed limit (0.1·h per step)
   plate.travel_time_s = 1;
   s.indenters = {plate};
   s.stop.equilibrium = 0;
