@@ -12,5 +12,3 @@ export VOXBREAST_CACHE_DIR=${VOXBREAST_CACHE_DIR:-$build/program-cache}
 cd "$build"
 # Long validation studies and GPU-only checks are labelled and run apart (README, "Quick start").
 ctest --output-on-failure --parallel "$(nproc)" --timeout 1200 -LE "slow|validation|gpu"
-# The io and engine unit tests again under ASan and UBSan, in build-sanitize/.
-bash "$root/scripts/sanitize.sh"
