@@ -13,7 +13,7 @@ bin=${VOXBREAST_BIN:-$here/../../build/apps/voxbreast}
 out=${1:-out/device_sweep}
 shift || true
 exec "$bin" sweep "$here/scene_device.toml" \
-  --vary device.torus.2.major_radius=0.050:0.056:3 \
+  --vary device.torus.2.major_radius=0.053:0.056:3 \
   --vary reproducibility.perturbations=2 \
   --vary solver.integrator=relaxation \
   --out "$out" "$@"
