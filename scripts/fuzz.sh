@@ -16,7 +16,8 @@
 #   BUILD_DIR      CMake build folder (default build, relative to the repository root)
 #   FUZZ_SECONDS   seconds of fuzzing per target (default 15); the targets run at once
 #   FUZZ_CXX       compiler (default clang++)
-#   FUZZ_TARGETS   targets to build and run (default "fuzz_nifti fuzz_dicom_series fuzz_scene_file")
+#   FUZZ_TARGETS   targets to build and run (default "fuzz_nifti fuzz_dicom_series"; fuzz_scene_file does
+#                  not link yet: the scene parser needs more of the engine than its list below)
 #
 # Targets and objects go to ${BUILD_DIR}/fuzz/ (objects are rebuilt only when a source, a header
 # it includes or the flags change). Each target fuzzes a fresh copy of tests/fuzz/corpus/<name>/
@@ -33,7 +34,7 @@ build_dir=${BUILD_DIR:-build}
 [[ $build_dir = /* ]] || build_dir=$root/$build_dir
 seconds=${FUZZ_SECONDS:-15}
 cxx=${FUZZ_CXX:-clang++}
-targets=${FUZZ_TARGETS:-fuzz_nifti fuzz_dicom_series fuzz_scene_file}
+targets=${FUZZ_TARGETS:-fuzz_nifti fuzz_dicom_series}
 out=$build_dir/fuzz
 
 fail_setup() {

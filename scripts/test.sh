@@ -11,4 +11,4 @@ export VOXBREAST_DEVICE=${VOXBREAST_DEVICE:-cpu}
 export VOXBREAST_CACHE_DIR=${VOXBREAST_CACHE_DIR:-$build/program-cache}
 cd "$build"
 # Long validation studies and GPU-only checks are labelled and run apart (README, "Quick start").
-ctest --output-on-failure --parallel "$(nproc)" --timeout 1200 -LE "slow|validation|gpu"
+ctest --output-on-failure --parallel "$(nproc)" --timeout 1200 -LE "slow|validation|gpu" -E "Study\.|Gpu\."
