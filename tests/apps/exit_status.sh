@@ -8,27 +8,9 @@ root=${1:?source dir}
 bin=${VOXBREAST_BIN:?path to voxbreast}
 source "$(dirname "$0")/lib.sh"
 
-scene() {  # a small block on a held base under gravity; extra lines appended
-  cat <<TOML
-[model]
-spacing = 0.002
-[[model.shape]]
-kind = "box"
-min = [0.0, 0.0, 0.0]
-max = [0.01, 0.01, 0.01]
-label = "soft"
-[materials.soft]
-E = 3000.0
-[gravity]
-vector = [0.0, 0.0, -9.81]
-[anchor.base]
-kind = "halfspace"
-point = [0.0, 0.0, 0.002]
-normal = [0.0, 0.0, -1.0]
-[solver]
-integrator = "relaxation"
-precision = "double"
-TOML
+scene() {  # the shared block (lib.sh), relaxed in double; extra lines appended
+  block_scene
+  printf '[solver]\nintegrator = "relaxation"\nprecision = "double"\n'
 }
 run() {  # name, scene text: runs simulate, sets rc
   printf '%s\n' "$2" >"$work/$1.toml"
