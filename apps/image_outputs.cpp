@@ -1,13 +1,18 @@
 #include "apps/image_outputs.hpp"
 
 #include <cmath>
+#include <fstream>
+#include <optional>
+#include <sstream>
 
 #include "engine/image/deformation_field.hpp"
 #include "engine/image/displacement_stats.hpp"
 #include "engine/image/source_slices.hpp"
 #include "io/dicom_io.hpp"
+#include "engine/image/structure_set.hpp"
 #include "io/metaimage_io.hpp"
 #include "io/nifti_io.hpp"
+#include "io/rtstruct.hpp"
 #include "io/scene_file.hpp"
 
 namespace vb::app {
@@ -36,53 +41,124 @@ void write_dvf(const std::string& dir, const std::string& name, const ImageVolum
                                  {"mean_length", s.mean_length_mm}, {"max_length", s.max_length_mm}};
 }
 
+
+/// A field of /proc/self/status in bytes ("VmHWM": peak resident memory, "VmRSS": now), or
+/// nothing where there is no such file.
+std::optional<double> process_memory_bytes(const std::string& field) {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind(field + ":", 0) == 0) {
+      std::istringstream in(line.substr(field.size() + 1));
+      double kib = 0;
+      if (in >> kib) return 1024 * kib;
+    }
+  return std::nullopt;
+}
+
+/// Starts the peak of resident memory afresh (Linux: "5" written to /proc/self/clear_refs).
+void reset_peak_memory() { std::ofstream("/proc/self/clear_refs") << "5"; }
+
+/// Shares out the progress of the image outputs over their steps, weighted by their cost.
+class Steps {
+ public:
+  Steps(const ImageOutputProgress& progress, double total) : progress_(progress), total_(total) {}
+  /// A step of `weight` starts; the returned callback reports its own fraction done.
+  ImageProgress step(const std::string& what, double weight) {
+    done_ += weight_;
+    weight_ = weight;
+    if (progress_) progress_(what, done_ / total_);
+    return [this, what](double fraction) {
+      if (progress_) progress_(what, (done_ + fraction * weight_) / total_);
+    };
+  }
+
+ private:
+  const ImageOutputProgress& progress_;
+  double total_, done_ = 0, weight_ = 0;
+};
+
 }  // namespace
 
-nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, const Lattice& lattice,
-                                   const ImageVolume& ct, const FinalState& state) {
+nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, const PreparedModel& model,
+                                   const FinalState& state, const ImageOutputProgress& progress) {
   const OutputSpec& want = scene.output;
+  const Lattice& lattice = model.lattice;
+  const ImageVolume& ct = *model.ct;
+  const ImageVolume* labels = model.labels ? &*model.labels : nullptr;
   nlohmann::json written = nlohmann::json::object();
+  const std::optional<double> memory_before = process_memory_bytes("VmRSS");
+  reset_peak_memory();
   const LatticeField field(lattice, state.displacement_m);
   const DvfFileOptions files = dvf_file_options(scene);
-  if (want.dvf) write_dvf(dir, "dvf", ct, forward_displacement_on_grid(field, ct), files, written);
-  if (want.dvf || want.warped_ct || want.warped_ct_dicom) {
-    const WarpResult warp = warp_image(ct, lattice, state.displacement_m);
-    if (want.dvf) write_dvf(dir, "dvf_inverse", ct, warp.inverse_field, files, written);
+  const bool warp = want.dvf || want.warped_ct || want.warped_ct_dicom;
+  // Weights: rough shares of the time each step takes (the inverse solve dominates).
+  const bool structures = labels && want.warped_ct_dicom;
+  Steps steps(progress, (want.dvf ? 2 : 0) + (warp ? 6 : 0) + (want.warped_ct_dicom ? 1 : 0) + (structures ? 1 : 0) +
+                            (want.fields ? 2 : 0));
+  if (want.dvf) {
+    const ImageProgress report = steps.step("forward DVF", 2);
+    write_dvf(dir, "dvf", ct, forward_displacement_on_grid(field, ct, report), files, written);
+  }
+  if (warp) {
+    WarpResult w =
+        warp_image(ct, lattice, state.displacement_m, 30, steps.step("inverse DVF and warped CT", 6), labels);
+    if (want.dvf) write_dvf(dir, "dvf_inverse", ct, w.inverse_field, files, written);
     if (want.warped_ct) {
-      write_nifti(dir + "/warped_ct.nii.gz", warp.warped, NiftiType::Int16);
+      write_nifti(dir + "/warped_ct.nii.gz", w.warped, NiftiType::Int16);
       written["warped_ct"] = "warped_ct.nii.gz";
     }
     if (want.warped_ct_dicom) {
+      steps.step("warped CT series", 1);
       DicomSeriesOptions series;
       series.series_description = "VoxBreast warped CT";
       series.patient_position = dicom_patient_position(scene.gravity.active ? scene.gravity.acceleration_m_s2 : Vec3::Zero());
-      if (!ct.dicom_tags.empty()) series.source_slices = source_slices_read(ct, warp.inverse_field);
+      if (!ct.dicom_tags.empty()) series.source_slices = source_slices_read(ct, w.inverse_field);
       // a rerun replaces its own earlier series
-      const WrittenDicomSeries warped = replace_dicom_series(dir + "/warped_ct_dicom", warp.warped, series);
+      const WrittenDicomSeries warped = replace_dicom_series(dir + "/warped_ct_dicom", w.warped, series);
       written["warped_ct_dicom"] = "warped_ct_dicom/";
       if (files.dicom) {
-        write_dicom_deformable_registration(dir + "/dvf_inverse.dcm", ct, warp.inverse_field, ct, warped);
+        write_dicom_deformable_registration(dir + "/dvf_inverse.dcm", ct, w.inverse_field, ct, warped);
         written["dvf_inverse_dicom"] = "dvf_inverse.dcm";
       }
     }
-    written["warp_vacated_voxels"] = warp.vacated_voxels;
-    written["warp_max_inversion_residual_m"] = warp.max_fixed_point_residual_m;
+    std::vector<float>().swap(w.inverse_field);  // not needed by what follows
+    if (labels) {
+      write_nifti(dir + "/warped_labels.nii.gz", w.warped_labels, NiftiType::Int16);
+      written["warped_labels"] = "warped_labels.nii.gz";
+    }
+    if (structures) {
+      steps.step("warped structures", 1);
+      write_rtstruct(dir + "/warped_structures.dcm", structures_of_labels(w.warped_labels, model.label_names),
+                     dir + "/warped_ct_dicom", "VoxBreast warped");
+      written["warped_structures"] = "warped_structures.dcm";
+    }
+    written["warp_vacated_voxels"] = w.vacated_voxels;
+    written["warp_max_inversion_residual_m"] = w.max_fixed_point_residual_m;
   }
   if (want.fields) {
+    const ImageProgress report = steps.step("maps", 2);
     std::vector<double> tissue(lattice.element_count());
     for (std::size_t e = 0; e < tissue.size(); ++e) tissue[e] = lattice.tissue_of_element[e] + 1;
-    write_nifti(dir + "/model_labels.nii.gz", rasterise_elements(field, ct, tissue, 0.f), NiftiType::UInt8);
-    write_nifti(dir + "/displacement_mm.nii.gz", rasterise_elements(field, ct, displacement_norm_mm(state), 0.f),
-                NiftiType::Float32);
-    write_nifti(dir + "/equivalent_strain.nii.gz", rasterise_elements(field, ct, state.equivalent_strain, 0.f),
-                NiftiType::Float32);
-    write_nifti(dir + "/von_mises_stress_pa.nii.gz", rasterise_elements(field, ct, state.von_mises_stress_pa, 0.f),
-                NiftiType::Float32);
+    const std::vector<std::pair<std::string, std::vector<double>>> maps = {
+        {"model_labels.nii.gz", tissue},
+        {"displacement_mm.nii.gz", displacement_norm_mm(state)},
+        {"equivalent_strain.nii.gz", state.equivalent_strain},
+        {"von_mises_stress_pa.nii.gz", state.von_mises_stress_pa}};
+    for (std::size_t m = 0; m < maps.size(); ++m) {
+      write_nifti(dir + "/" + maps[m].first, rasterise_elements(field, ct, maps[m].second, 0.f),
+                  m == 0 ? NiftiType::UInt8 : NiftiType::Float32);
+      report(double(m + 1) / double(maps.size()));
+    }
     nlohmann::json names = nlohmann::json::object();
     for (std::size_t t = 0; t < lattice.tissue_names.size(); ++t) names[std::to_string(t + 1)] = lattice.tissue_names[t];
     written["model_labels"] = {{"file", "model_labels.nii.gz"}, {"values", names}};
     written["fields"] = {"displacement_mm.nii.gz", "equivalent_strain.nii.gz", "von_mises_stress_pa.nii.gz"};
   }
+  const std::optional<double> peak = process_memory_bytes("VmHWM");
+  if (memory_before && peak)
+    written["host_memory"] = {{"before_bytes", *memory_before},
+                              {"peak_bytes", *peak},
+                              {"ct_float_bytes", double(4 * ct.voxel_count())}};
   return written;
 }
 
