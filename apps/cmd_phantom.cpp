@@ -78,7 +78,8 @@ int run_phantom(const PhantomOptions& o) {
   std::map<int, std::string> present;
   for (const float v : p.labels.values)
     if (v > 0 && !present.count(int(v))) present[int(v)] = p.label_names[std::size_t(v)];
-  write_rtstruct(dir + "/rtstruct.dcm", structures_of_labels(p.labels, present), dir + "/dicom", "VoxBreast phantom");
+  write_rtstruct(dir + "/rtstruct.dcm", structures_of_labels(p.labels, present), dir + "/dicom", "VoxBreast phantom",
+                 /*deterministic=*/true);
   write_text_atomically(dir + "/scene.toml", phantom_scene(p, spec));
   folder.commit();
   const Eigen::Vector3d h_mm = 1e3 * p.ct.spacing_m();

@@ -32,6 +32,7 @@ namespace fs = std::filesystem;
 
 namespace vb {
 using namespace dicom;
+
 namespace {
 
 /// Slice grid of a volume in DICOM terms (mm, LPS).
@@ -149,24 +150,6 @@ std::string content_digest(const ImageVolume& ct, const std::string& description
   sha.add(ct.affine_lps_m.data(), sizeof(double) * 16);
   sha.add(ct.values.data(), sizeof(float) * ct.values.size());
   return sha.finish();
-}
-
-/// A name-based (SHA-1, version 5) UUID of `name` as a DICOM UID under the 2.25 root
-/// (PS3.5 B.2): the same name always gives the same UID.
-std::string name_based_uid(const std::string& name) {
-  // RFC 4122 version 5 in VoxBreast's own namespace (a fixed random UUID).
-  static const unsigned char kNamespace[16] = {0x3c, 0x8e, 0x52, 0x0b, 0x9d, 0x41, 0x4f, 0x6a,
-                                               0xa7, 0x1e, 0x0c, 0x55, 0xd2, 0x93, 0x68, 0xf4};
-  Digest sha1(EVP_sha1());
-  sha1.add(kNamespace, sizeof kNamespace);
-  sha1.add(name.data(), name.size());
-  const std::string digest = sha1.finish();
-  OFUUID::BinaryRepresentation bytes;
-  std::copy(digest.begin(), digest.begin() + 16, bytes.value);
-  bytes.value[6] = Uint8((bytes.value[6] & 0x0f) | 0x50);  // version 5
-  bytes.value[8] = Uint8((bytes.value[8] & 0x3f) | 0x80);  // RFC 4122 variant
-  OFString text;
-  return OFUUID(bytes).toString(text, OFUUID::ER_RepresentationOID).c_str();
 }
 
 /// Fresh UIDs, or (deterministic) UIDs named after the volume's content and the UID's role.
@@ -659,6 +642,24 @@ WrittenDicomSeries replace_dicom_series(const std::string& dir, const ImageVolum
   require(!ec, "the new series is in place, but the earlier one could not be removed: " + ec.message(),
           old_dir.string());
   return written;
+}
+
+/// A name-based (SHA-1, version 5) UUID of `name` as a DICOM UID under the 2.25 root
+/// (PS3.5 B.2): the same name always gives the same UID.
+std::string dicom::name_based_uid(const std::string& name) {
+  // RFC 4122 version 5 in VoxBreast's own namespace (a fixed random UUID).
+  static const unsigned char kNamespace[16] = {0x3c, 0x8e, 0x52, 0x0b, 0x9d, 0x41, 0x4f, 0x6a,
+                                               0xa7, 0x1e, 0x0c, 0x55, 0xd2, 0x93, 0x68, 0xf4};
+  Digest sha1(EVP_sha1());
+  sha1.add(kNamespace, sizeof kNamespace);
+  sha1.add(name.data(), name.size());
+  const std::string digest = sha1.finish();
+  OFUUID::BinaryRepresentation bytes;
+  std::copy(digest.begin(), digest.begin() + 16, bytes.value);
+  bytes.value[6] = Uint8((bytes.value[6] & 0x0f) | 0x50);  // version 5
+  bytes.value[8] = Uint8((bytes.value[8] & 0x3f) | 0x80);  // RFC 4122 variant
+  OFString text;
+  return OFUUID(bytes).toString(text, OFUUID::ER_RepresentationOID).c_str();
 }
 
 }  // namespace vb

@@ -14,6 +14,7 @@
 
 #include "engine/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/dicom_attributes.hpp"
 #include "voxbreast/config.hpp"
 
 namespace vb {
@@ -83,6 +84,7 @@ std::string new_uid(const char* root) {
 }  // namespace
 
 StructureSet read_rtstruct(const std::string& path) {
+  dicom::init_dcmtk();
   DcmFileFormat ff;
   check(ff.loadFile(path.c_str()), "cannot read the DICOM file", path);
   DRTStructureSetIOD rt;
@@ -146,14 +148,22 @@ StructureSet read_rtstruct(const std::string& path) {
 }
 
 void write_rtstruct(const std::string& path, const StructureSet& set, const std::string& ct_series_dir,
-                    const std::string& label) {
+                    const std::string& label, bool deterministic) {
+  dicom::init_dcmtk();
   const ReferencedSeries ct = read_referenced_series(ct_series_dir);
   DRTStructureSetIOD rt;
   const auto put = [&](const OFCondition& status, const char* what) { check(status, std::string("cannot set ") + what, path); };
-  char date[16], clock[16];
-  const std::time_t now = std::time(nullptr);
-  std::strftime(date, sizeof date, "%Y%m%d", std::gmtime(&now));
-  std::strftime(clock, sizeof clock, "%H%M%S", std::gmtime(&now));
+  char date[16] = "", clock[16] = "";  // Structure Set Date and Time are type 2: empty when deterministic
+  if (!deterministic) {
+    const std::time_t now = std::time(nullptr);
+    std::strftime(date, sizeof date, "%Y%m%d", std::gmtime(&now));
+    std::strftime(clock, sizeof clock, "%H%M%S", std::gmtime(&now));
+  }
+  // Deterministic UIDs are named after the referenced series (itself named after its content)
+  // and the label, so the same structures on the same series give a byte-identical file.
+  const auto uid = [&](const char* root, const char* role) {
+    return deterministic ? dicom::name_based_uid(ct.series_uid + "/" + label + "/" + role) : new_uid(root);
+  };
   put(rt.setPatientName(ct.patient_study.at(DCM_PatientName).c_str()), "PatientName");
   put(rt.setPatientID(ct.patient_study.at(DCM_PatientID).c_str()), "PatientID");
   put(rt.setPatientBirthDate(ct.patient_study.at(DCM_PatientBirthDate).c_str()), "PatientBirthDate");
@@ -167,14 +177,14 @@ void write_rtstruct(const std::string& path, const StructureSet& set, const std:
   put(rt.setPositionReferenceIndicator(""), "PositionReferenceIndicator");
   put(rt.setAccessionNumber(ct.patient_study.at(DCM_AccessionNumber).c_str()), "AccessionNumber");
   put(rt.setModality("RTSTRUCT"), "Modality");
-  put(rt.setSeriesInstanceUID(new_uid(SITE_SERIES_UID_ROOT).c_str()), "SeriesInstanceUID");
+  put(rt.setSeriesInstanceUID(uid(SITE_SERIES_UID_ROOT, "rtstruct series").c_str()), "SeriesInstanceUID");
   put(rt.setSeriesNumber("9001"), "SeriesNumber");
   put(rt.setSeriesDescription(label.c_str()), "SeriesDescription");
   put(rt.setOperatorsName(""), "OperatorsName");
   put(rt.setManufacturer("VoxBreast"), "Manufacturer");
   put(rt.setSoftwareVersions(config::version), "SoftwareVersions");
   put(rt.setSOPClassUID(UID_RTStructureSetStorage), "SOPClassUID");
-  put(rt.setSOPInstanceUID(new_uid(SITE_INSTANCE_UID_ROOT).c_str()), "SOPInstanceUID");
+  put(rt.setSOPInstanceUID(uid(SITE_INSTANCE_UID_ROOT, "rtstruct instance").c_str()), "SOPInstanceUID");
   put(rt.setInstanceNumber("1"), "InstanceNumber");
   put(rt.setStructureSetLabel(label.substr(0, 16).c_str()), "StructureSetLabel");
   put(rt.setStructureSetDate(date), "StructureSetDate");

@@ -15,8 +15,10 @@ StructureSet read_rtstruct(const std::string& path);
 
 /// Writes `set` as an RTSTRUCT referencing the CT series in `ct_series_dir` (its patient, study,
 /// frame of reference, series and every image; read from its files), with a new series and
-/// instance UID. The file appears atomically.
+/// instance UID (deterministic: UIDs named after the referenced series and `label`, and no
+/// structure set date or time, so the same input gives the same bytes). The file appears
+/// atomically.
 void write_rtstruct(const std::string& path, const StructureSet& set, const std::string& ct_series_dir,
-                    const std::string& label);
+                    const std::string& label, bool deterministic = false);
 
 }  // namespace vb

@@ -66,8 +66,9 @@ then pass "pydicom reads the phantom's structures and their references"; else fa
 if plastimatch_agrees "$work/ph/rtstruct.dcm" "$work/ph/dicom" "$work/ph/labels.nii.gz" "$names"; then
   pass "plastimatch convert rasterises the phantom's contours to its label map"; else fail "plastimatch phantom"; fi
 
-# The structures instead of the label map: the same model; the outputs carry them.
-sed -e 's|^labels = "labels.nii.gz"|structures = "rtstruct.dcm"|' -e 's|^\[model.label_table\]|[model.structure_table]|' \
+# The structures instead of the label map: the same model; the outputs carry them. The CT is the
+# DICOM series, so the structures' frame of reference is checked against the CT's.
+sed -e 's|^image = "ct.nii.gz"|image = "dicom"|' -e 's|^labels = "labels.nii.gz"|structures = "rtstruct.dcm"|' -e 's|^\[model.label_table\]|[model.structure_table]|' \
     -e 's|^[0-9] = \("[a-z]*"\)|\1 = \1|' -e 's|^max_steps = .*|max_steps = 300|' \
     "$work/ph/scene.toml" >"$work/ph/structures.toml"
 sed -e 's|^max_steps = .*|max_steps = 300|' "$work/ph/scene.toml" >"$work/ph/labels.toml"
@@ -92,14 +93,52 @@ then pass "warped_structures.dcm references the warped CT series"; else fail "wa
 if plastimatch_agrees "$out/warped_structures.dcm" "$out/warped_ct_dicom" "$out/warped_labels.nii.gz" "$names"; then
   pass "plastimatch convert rasterises the warped contours to warped_labels.nii.gz"; else fail "plastimatch warped"; fi
 
-# Bad structures: one line naming the ROI, non-zero exit, no result.
+# Bad structures: one line naming the ROI, non-zero exit, no result. Each case is the phantom's
+# rtstruct.dcm changed by pydicom (python below) and/or the scene changed by sed.
+edit_rtstruct() {  # name, python statements on `rs` (the dataset) and `roi(name)` (its contour item)
+  /usr/bin/python3 - "$work/ph/rtstruct.dcm" "$work/ph/$1.dcm" "$2" <<'PY'
+import sys, copy, pydicom
+rs = pydicom.dcmread(sys.argv[1])
+number = {r.ROIName: r.ROINumber for r in rs.StructureSetROISequence}
+def roi(name):
+    return next(c for c in rs.ROIContourSequence if c.ReferencedROINumber == number[name])
+def info(name):
+    return next(r for r in rs.StructureSetROISequence if r.ROIName == name)
+exec(sys.argv[3])
+rs.save_as(sys.argv[2])
+PY
+}
 bad() {  # name, sed expression on structures.toml, expected text
   sed -e "$2" "$work/ph/structures.toml" >"$work/ph/bad.toml"
   if "$bin" simulate "$work/ph/bad.toml" --out "$work/bad_$1" --quiet >"$work/bad.txt" 2>&1; then fail "$1: exit 0"; return; fi
-  if [[ $(grep -c . "$work/bad.txt") -eq 1 ]] && grep -q "$3" "$work/bad.txt" && [[ ! -e $work/bad_$1/result.h5 ]]; then
+  if [[ $(grep -c . "$work/bad.txt") -eq 1 ]] && grep -q "$3" "$work/bad.txt" && [[ ! -e $work/bad_$1/result.h5 ]] \
+     && [[ ! -e $work/bad_$1/summary.json ]]; then
     pass "$1: $(cat "$work/bad.txt")"; else fail "$1"; cat "$work/bad.txt"; fi
 }
+use() { echo "s|^structures = \"rtstruct.dcm\"|structures = \"$1.dcm\"|"; }
 bad unmapped '/^tumour = /d' "ROI 'tumour'.*maps to no tissue"
 bad missing_roi 's|^skin = "skin"|skin = "skin"\nnipple = "skin"|' "ROI 'nipple'"
+edit_rtstruct frame 'info("tumour").ReferencedFrameOfReferenceUID = "1.2.826.0.1.3680043.2.1125.1"'
+bad frame "$(use frame)" "ROI 'tumour'.*frame of reference.*not the CT's"
+edit_rtstruct outside 'c = roi("tumour").ContourSequence[0]; d = [float(v) for v in c.ContourData]; d[0] += 1000; c.ContourData = d'
+bad outside "$(use outside)" "ROI 'tumour'.*outside the image"
+edit_rtstruct malformed 'c = roi("tumour").ContourSequence[0]; c.NumberOfContourPoints = int(c.NumberOfContourPoints) + 1'
+bad malformed "$(use malformed)" "ROI 'tumour'.*malformed"
+edit_rtstruct open_contour 'roi("tumour").ContourSequence[0].ContourGeometricType = "OPEN_PLANAR"'
+bad open_contour "$(use open_contour)" "ROI 'tumour'.*OPEN_PLANAR"
+# A boost volume drawn over the tumour: an overlap that needs a priority rule.
+edit_rtstruct overlap '
+new = copy.deepcopy(info("tumour")); new.ROINumber = 99; new.ROIName = "boost"; rs.StructureSetROISequence.append(new)
+c = copy.deepcopy(roi("tumour")); c.ReferencedROINumber = 99; rs.ROIContourSequence.append(c)
+o = copy.deepcopy(rs.RTROIObservationsSequence[0]); o.ObservationNumber = 99; o.ReferencedROINumber = 99
+rs.RTROIObservationsSequence.append(o)'
+bad overlap "$(use overlap)"'
+s|^tumour = "tumour"|tumour = "tumour"\nboost = "tumour"|' "ROI 'boost'.*overlaps ROI 'tumour'.*no priority rule"
+sed -e "$(use overlap)" -e 's|^tumour = "tumour"|tumour = "tumour"\nboost = "tumour"|' \
+    -e 's|^\[model.structure_table\]|structure_priority = ["boost", "tumour"]\n\n[model.structure_table]|' \
+    "$work/ph/structures.toml" >"$work/ph/priority.toml"
+if "$bin" simulate "$work/ph/priority.toml" --out "$work/priority" --quiet >"$work/priority.txt" 2>&1 \
+   && [[ -e $work/priority/summary.json ]]; then
+  pass "model.structure_priority settles the overlap"; else fail "structure_priority"; cat "$work/priority.txt"; fi
 
 finish
