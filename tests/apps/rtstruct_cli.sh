@@ -69,9 +69,9 @@ if plastimatch_agrees "$work/ph/rtstruct.dcm" "$work/ph/dicom" "$work/ph/labels.
 # The structures instead of the label map: the same model; the outputs carry them. The CT is the
 # DICOM series, so the structures' frame of reference is checked against the CT's.
 sed -e 's|^image = "ct.nii.gz"|image = "dicom"|' -e 's|^labels = "labels.nii.gz"|structures = "rtstruct.dcm"|' -e 's|^\[model.label_table\]|[model.structure_table]|' \
-    -e 's|^[0-9] = \("[a-z]*"\)|\1 = \1|' -e 's|^max_steps = .*|max_steps = 300|' \
+    -e 's|^[0-9] = \("[a-z]*"\)|\1 = \1|' -e 's|^max_steps = .*|max_steps = 300|' -e 's|^equilibrium = .*|equilibrium = 0.0|' \
     "$work/ph/scene.toml" >"$work/ph/structures.toml"
-sed -e 's|^max_steps = .*|max_steps = 300|' "$work/ph/scene.toml" >"$work/ph/labels.toml"
+sed -e 's|^max_steps = .*|max_steps = 300|' -e 's|^equilibrium = .*|equilibrium = 0.0|' "$work/ph/scene.toml" >"$work/ph/labels.toml"
 "$bin" simulate "$work/ph/labels.toml" --out "$work/by_labels" --quiet >"$work/labels.txt" 2>&1
 if "$bin" simulate "$work/ph/structures.toml" --out "$work/by_structures" --quiet >"$work/structures.txt" 2>&1 \
    && cmp -s <(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["elements"])' "$work/by_labels/summary.json") \
@@ -116,8 +116,8 @@ bad() {  # name, sed expression on structures.toml, expected text
     pass "$1: $(cat "$work/bad.txt")"; else fail "$1"; cat "$work/bad.txt"; fi
 }
 use() { echo "s|^structures = \"rtstruct.dcm\"|structures = \"$1.dcm\"|"; }
-bad unmapped '/^tumour = /d' "ROI 'tumour'.*maps to no tissue"
-bad missing_roi 's|^skin = "skin"|skin = "skin"\nnipple = "skin"|' "ROI 'nipple'"
+bad unmapped '/^"tumour" = /d' "ROI 'tumour'.*maps to no tissue"
+bad missing_roi 's|^"skin" = "skin"|"skin" = "skin"\n"nipple" = "skin"|' "ROI 'nipple'"
 edit_rtstruct frame 'info("tumour").ReferencedFrameOfReferenceUID = "1.2.826.0.1.3680043.2.1125.1"'
 bad frame "$(use frame)" "ROI 'tumour'.*frame of reference.*not the CT's"
 edit_rtstruct outside 'c = roi("tumour").ContourSequence[0]; d = [float(v) for v in c.ContourData]; d[0] += 1000; c.ContourData = d'
@@ -133,8 +133,8 @@ c = copy.deepcopy(roi("tumour")); c.ReferencedROINumber = 99; rs.ROIContourSeque
 o = copy.deepcopy(rs.RTROIObservationsSequence[0]); o.ObservationNumber = 99; o.ReferencedROINumber = 99
 rs.RTROIObservationsSequence.append(o)'
 bad overlap "$(use overlap)"'
-s|^tumour = "tumour"|tumour = "tumour"\nboost = "tumour"|' "ROI 'boost'.*overlaps ROI 'tumour'.*no priority rule"
-sed -e "$(use overlap)" -e 's|^tumour = "tumour"|tumour = "tumour"\nboost = "tumour"|' \
+s|^"tumour" = "tumour"|"tumour" = "tumour"\n"boost" = "tumour"|' "ROI 'boost'.*overlaps ROI 'tumour'.*no priority rule"
+sed -e "$(use overlap)" -e 's|^"tumour" = "tumour"|"tumour" = "tumour"\n"boost" = "tumour"|' \
     -e 's|^\[model.structure_table\]|structure_priority = ["boost", "tumour"]\n\n[model.structure_table]|' \
     "$work/ph/structures.toml" >"$work/ph/priority.toml"
 if "$bin" simulate "$work/ph/priority.toml" --out "$work/priority" --quiet >"$work/priority.txt" 2>&1 \
