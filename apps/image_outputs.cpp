@@ -1,5 +1,6 @@
 #include "apps/image_outputs.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <optional>
@@ -58,23 +59,41 @@ std::optional<double> process_memory_bytes(const std::string& field) {
 /// Starts the peak of resident memory afresh (Linux: "5" written to /proc/self/clear_refs).
 void reset_peak_memory() { std::ofstream("/proc/self/clear_refs") << "5"; }
 
-/// Shares out the progress of the image outputs over their steps, weighted by their cost.
+/// Shares out the progress of the image outputs over their steps, weighted by their cost, and
+/// times each step (wall-clock seconds, summary.json `image_outputs.step_seconds`).
 class Steps {
  public:
+  using Clock = std::chrono::steady_clock;
   Steps(const ImageOutputProgress& progress, double total) : progress_(progress), total_(total) {}
-  /// A step of `weight` starts; the returned callback reports its own fraction done.
+  /// A step of `weight` starts (the one before ends); the returned callback reports its own fraction done.
   ImageProgress step(const std::string& what, double weight) {
+    close();
     done_ += weight_;
     weight_ = weight;
+    what_ = what;
     if (progress_) progress_(what, done_ / total_);
     return [this, what](double fraction) {
       if (progress_) progress_(what, (done_ + fraction * weight_) / total_);
     };
   }
+  /// Ends the step under way; the seconds of every step so far.
+  const nlohmann::json& seconds() {
+    close();
+    return seconds_;
+  }
 
  private:
+  void close() {
+    const Clock::time_point now = Clock::now();
+    if (!what_.empty()) seconds_[what_] = seconds_.value(what_, 0.0) + std::chrono::duration<double>(now - start_).count();
+    what_.clear();
+    start_ = now;
+  }
   const ImageOutputProgress& progress_;
   double total_, done_ = 0, weight_ = 0;
+  std::string what_;
+  Clock::time_point start_ = Clock::now();
+  nlohmann::json seconds_ = nlohmann::json::object();
 };
 
 }  // namespace
@@ -93,20 +112,23 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
   const bool warp = want.dvf || want.warped_ct || want.warped_ct_dicom;
   // Weights: rough shares of the time each step takes (the inverse solve dominates).
   const bool structures = labels && want.warped_ct_dicom;
-  Steps steps(progress, (want.dvf ? 2 : 0) + (warp ? 6 : 0) + (want.warped_ct_dicom ? 1 : 0) + (structures ? 1 : 0) +
+  Steps steps(progress, (want.dvf ? 2 : 0) + (warp ? 6 : 0) + (want.warped_ct_dicom ? 1 : 0) + (labels && warp ? 1 : 0) +
                             (want.fields ? 2 : 0));
+  // Memory: besides the CT and its labels, at most the forward field (3 floats a voxel), or the
+  // inverse field and the warped CT (3 + 1), or the inverse field and the warped labels (3 + 1)
+  // are held at once; every file is written from them in blocks.
   if (want.dvf) {
     const ImageProgress report = steps.step("forward DVF", 2);
     write_dvf(dir, "dvf", ct, forward_displacement_on_grid(field, ct, report), files, written);
   }
   if (warp) {
-    WarpResult w =
-        warp_image(ct, lattice, state.displacement_m, 30, steps.step("inverse DVF and warped CT", 6), labels);
+    WarpResult w = warp_image(ct, lattice, state.displacement_m, 30, steps.step("inverse DVF and warped CT", 6));
     if (want.dvf) write_dvf(dir, "dvf_inverse", ct, w.inverse_field, files, written);
     if (want.warped_ct) {
       write_nifti(dir + "/warped_ct.nii.gz", w.warped, NiftiType::Int16);
       written["warped_ct"] = "warped_ct.nii.gz";
     }
+    std::optional<WrittenDicomSeries> warped_series;
     if (want.warped_ct_dicom) {
       steps.step("warped CT series", 1);
       DicomSeriesOptions series;
@@ -114,26 +136,28 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
       series.patient_position = dicom_patient_position(scene.gravity.active ? scene.gravity.acceleration_m_s2 : Vec3::Zero());
       if (!ct.dicom_tags.empty()) series.source_slices = source_slices_read(ct, w.inverse_field);
       // a rerun replaces its own earlier series
-      const WrittenDicomSeries warped = replace_dicom_series(dir + "/warped_ct_dicom", w.warped, series);
+      warped_series = replace_dicom_series(dir + "/warped_ct_dicom", w.warped, series);
       written["warped_ct_dicom"] = "warped_ct_dicom/";
-      if (files.dicom) {
-        write_dicom_deformable_registration(dir + "/dvf_inverse.dcm", ct, w.inverse_field, ct, warped);
-        written["dvf_inverse_dicom"] = "dvf_inverse.dcm";
-      }
     }
-    std::vector<float>().swap(w.inverse_field);  // not needed by what follows
-    if (labels) {
-      write_nifti(dir + "/warped_labels.nii.gz", w.warped_labels, NiftiType::Int16);
-      written["warped_labels"] = "warped_labels.nii.gz";
-    }
-    if (structures) {
-      steps.step("warped structures", 1);
-      write_rtstruct(dir + "/warped_structures.dcm", structures_of_labels(w.warped_labels, model.label_names),
-                     dir + "/warped_ct_dicom", "VoxBreast warped");
-      written["warped_structures"] = "warped_structures.dcm";
-    }
+    std::vector<float>().swap(w.warped.values);  // written: the warped labels take its place
     written["warp_vacated_voxels"] = w.vacated_voxels;
     written["warp_max_inversion_residual_m"] = w.max_fixed_point_residual_m;
+    if (labels) {
+      const ImageVolume warped_labels =
+          warp_labels(*labels, lattice, state.displacement_m, w.inverse_field, 30, steps.step("warped labels", 1));
+      write_nifti(dir + "/warped_labels.nii.gz", warped_labels, NiftiType::Int16);
+      written["warped_labels"] = "warped_labels.nii.gz";
+      if (structures) {
+        write_rtstruct(dir + "/warped_structures.dcm", structures_of_labels(warped_labels, model.label_names),
+                       dir + "/warped_ct_dicom", "VoxBreast warped");
+        written["warped_structures"] = "warped_structures.dcm";
+      }
+    }
+    if (warped_series && files.dicom) {
+      steps.step("registration object", 0);
+      write_dicom_deformable_registration(dir + "/dvf_inverse.dcm", ct, w.inverse_field, ct, *warped_series);
+      written["dvf_inverse_dicom"] = "dvf_inverse.dcm";
+    }
   }
   if (want.fields) {
     const ImageProgress report = steps.step("maps", 2);
@@ -154,6 +178,7 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
     written["model_labels"] = {{"file", "model_labels.nii.gz"}, {"values", names}};
     written["fields"] = {"displacement_mm.nii.gz", "equivalent_strain.nii.gz", "von_mises_stress_pa.nii.gz"};
   }
+  written["step_seconds"] = steps.seconds();
   const std::optional<double> peak = process_memory_bytes("VmHWM");
   if (memory_before && peak)
     written["host_memory"] = {{"before_bytes", *memory_before},

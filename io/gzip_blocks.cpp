@@ -49,17 +49,21 @@ void put_le32(std::vector<unsigned char>& out, std::uint32_t v) {
 }  // namespace
 
 bool write_blocks(std::FILE* file, const std::string& prefix, std::size_t payload_bytes, const FillBytes& fill,
-                  bool gzip, int level) {
+                  BlockCompression compression, int level) {
+  const bool gzip = compression != BlockCompression::None, zlib = compression == BlockCompression::Zlib;
   const std::size_t total = prefix.size() + payload_bytes;
   const std::size_t block_count = std::max<std::size_t>(1, (total + kBlockBytes - 1) / kBlockBytes);
   const std::size_t in_flight = chunk_count(block_count, 1);
   std::vector<Block> blocks(std::min(in_flight, block_count));
   bool ok = true;
-  if (gzip) {
+  if (zlib) {
+    static const unsigned char header[2] = {0x78, 0x9c};  // deflate, 32 KiB window; (0x789c % 31) == 0
+    ok = std::fwrite(header, 1, sizeof header, file) == sizeof header;
+  } else if (gzip) {
     static const unsigned char header[10] = {0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 0, 3};  // deflate, no name, Unix
     ok = std::fwrite(header, 1, sizeof header, file) == sizeof header;
   }
-  std::uint32_t crc = std::uint32_t(crc32(0, nullptr, 0));
+  std::uint32_t crc = std::uint32_t(zlib ? adler32(0, nullptr, 0) : crc32(0, nullptr, 0));
   for (std::size_t first = 0; first < block_count; first += blocks.size()) {
     const std::size_t round = std::min(blocks.size(), block_count - first);
     for_each_index_dynamic(round, [&](std::size_t r) {
@@ -73,7 +77,8 @@ bool write_blocks(std::FILE* file, const std::string& prefix, std::size_t payloa
         const std::size_t from = std::max(begin, prefix.size());
         if (end > from) fill(from - prefix.size(), b.raw.data() + (from - begin), end - from);
         if (gzip) {
-          b.crc = std::uint32_t(crc32(0, b.raw.data(), uInt(b.raw.size())));
+          b.crc = std::uint32_t(zlib ? adler32(1, b.raw.data(), uInt(b.raw.size()))
+                                     : crc32(0, b.raw.data(), uInt(b.raw.size())));
           deflate_block(b, level, first + r + 1 == block_count);
         }
       } catch (...) {
@@ -85,10 +90,15 @@ bool write_blocks(std::FILE* file, const std::string& prefix, std::size_t payloa
       if (b.error) std::rethrow_exception(b.error);
       const std::vector<unsigned char>& bytes = gzip ? b.packed : b.raw;
       ok = ok && std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
-      if (gzip) crc = std::uint32_t(crc32_combine(crc, b.crc, z_off_t(b.raw.size())));
+      if (zlib) crc = std::uint32_t(adler32_combine(crc, b.crc, z_off_t(b.raw.size())));
+      else if (gzip) crc = std::uint32_t(crc32_combine(crc, b.crc, z_off_t(b.raw.size())));
     }
   }
-  if (gzip) {
+  if (zlib) {
+    const unsigned char trailer[4] = {static_cast<unsigned char>(crc >> 24), static_cast<unsigned char>(crc >> 16),
+                                      static_cast<unsigned char>(crc >> 8), static_cast<unsigned char>(crc)};
+    ok = ok && std::fwrite(trailer, 1, sizeof trailer, file) == sizeof trailer;  // Adler-32, big-endian
+  } else if (gzip) {
     std::vector<unsigned char> trailer;
     put_le32(trailer, crc);
     put_le32(trailer, std::uint32_t(total & 0xffffffffu));

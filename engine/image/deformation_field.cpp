@@ -165,36 +165,47 @@ class Seeds {
   std::vector<Entry> entries_;
 };
 
+/// Solves x + u(x) = y for a tissue point x (inside the model) by fixed-point iteration from a
+/// start: iterations stop once |x + u(x) − y| is below a millionth of the smallest CT spacing,
+/// and a solution counts within a thousandth of it.
+class TissueSource {
+ public:
+  TissueSource(const LatticeField& field, const ImageVolume& ct, int iterations)
+      : field_(field), iterations_(iterations), tolerance_(1e-3 * ct.spacing_m().minCoeff()) {}
+  /// true with `found` and its `residual` when the iteration from `x` meets the tolerance in the model.
+  bool operator()(const Eigen::Vector3d& y, Eigen::Vector3d x, Eigen::Vector3d& found, double& residual) const {
+    const double converged = 1e-3 * tolerance_;  // iterations stop here; acceptance is at tolerance_
+    for (int it = 0;; ++it) {
+      const Eigen::Vector3d miss = x + field_.displacement_at(x) - y;
+      residual = miss.norm();
+      if (residual <= converged || it == iterations_) break;
+      x -= miss;
+    }
+    if (!(residual <= tolerance_) || field_.element_at(x) < 0) return false;
+    found = x;
+    return true;
+  }
+
+ private:
+  const LatticeField& field_;
+  int iterations_;
+  double tolerance_;
+};
+
 }  // namespace
 
 WarpResult warp_image(const ImageVolume& ct, const Lattice& lattice, const std::vector<double>& u, int iterations,
-                      const ImageProgress& progress, const ImageVolume* labels) {
+                      const ImageProgress& progress) {
   const LatticeField field(lattice, u);
-  require(!labels || (labels->dims == ct.dims && labels->values.size() == ct.voxel_count()),
-          "the label map's grid is not the CT's");
   WarpResult r;
   r.warped = ct;
-  if (labels) r.warped_labels = *labels;
   r.inverse_field.assign(3 * ct.voxel_count(), 0.f);
   const Eigen::Matrix4d to_index = ct.affine_lps_m.inverse();
   const float background = *std::min_element(ct.values.begin(), ct.values.end());
-  const double tolerance = 1e-3 * ct.spacing_m().minCoeff();
-  const double converged = 1e-3 * tolerance;  // iterations stop here; acceptance is at `tolerance`
   // Search radius for seeds: lattice elements can be sparser than CT voxels.
   const int reach = 1 + int(std::ceil(lattice.spacing_m / ct.spacing_m().minCoeff()));
   const Seeds seeds(ct, lattice, u, reach);
-  // A tissue point x (inside the model) with x + u(x) = y, iterated from x; its residual in `residual`.
-  auto tissue_source = [&](const Eigen::Vector3d& y, Eigen::Vector3d x, Eigen::Vector3d& found, double& residual) {
-    for (int it = 0;; ++it) {
-      const Eigen::Vector3d miss = x + field.displacement_at(x) - y;
-      residual = miss.norm();
-      if (residual <= converged || it == iterations) break;
-      x -= miss;
-    }
-    if (!(residual <= tolerance) || field.element_at(x) < 0) return false;
-    found = x;
-    return true;
-  };
+  const TissueSource tissue_source(field, ct, iterations);
   std::vector<double> slice_residual(std::size_t(std::max(0, ct.dims[2])), 0.0);
   std::vector<std::size_t> slice_vacated(slice_residual.size(), 0);
   for_each_slice(ct, [&](int k) {
@@ -222,16 +233,9 @@ WarpResult warp_image(const ImageVolume& ct, const Lattice& lattice, const std::
           slice_residual[std::size_t(k)] = std::max(slice_residual[std::size_t(k)], residual);
           const Eigen::Vector3d q = (to_index * x.homogeneous()).head<3>();
           r.warped.values[v] = sample(ct, q);
-          if (labels) {
-            const int a = std::clamp(int(std::lround(q[0])), 0, ct.dims[0] - 1),
-                      b = std::clamp(int(std::lround(q[1])), 0, ct.dims[1] - 1),
-                      c = std::clamp(int(std::lround(q[2])), 0, ct.dims[2] - 1);
-            r.warped_labels.values[v] = labels->values[ct.linear_index(a, b, c)];
-          }
           for (int c = 0; c < 3; ++c) r.inverse_field[3 * v + c] = float(x[c] - y[c]);
         } else if (field.element_at(y) >= 0) {  // tissue left this voxel and none arrived
           r.warped.values[v] = background;
-          if (labels) r.warped_labels.values[v] = 0;
           ++slice_vacated[std::size_t(k)];
         }  // else: background that no tissue reaches keeps its value
       }
@@ -242,6 +246,34 @@ WarpResult warp_image(const ImageVolume& ct, const Lattice& lattice, const std::
     r.vacated_voxels += slice_vacated[k];
   }
   return r;
+}
+
+ImageVolume warp_labels(const ImageVolume& labels, const Lattice& lattice, const std::vector<double>& u,
+                        const std::vector<float>& inverse_field, int iterations, const ImageProgress& progress) {
+  require(inverse_field.size() == 3 * labels.voxel_count(), "the inverse field's grid is not the label map's");
+  const LatticeField field(lattice, u);
+  const TissueSource tissue_source(field, labels, iterations);
+  const Eigen::Matrix4d to_index = labels.affine_lps_m.inverse();
+  ImageVolume out = labels;
+  for_each_voxel(labels, [&](int i, int j, int k, const Eigen::Vector3d& y) {
+    const std::size_t v = labels.linear_index(i, j, k);
+    const Eigen::Vector3d d(inverse_field[3 * v], inverse_field[3 * v + 1], inverse_field[3 * v + 2]);
+    Eigen::Vector3d x = y + d;
+    if (d.isZero()) {  // solved where it stands, vacated, or never reached: warp_image's own test
+      if (field.element_at(y) < 0) return;  // outside the model: no tissue arrived, keeps its label
+      double residual = 0;
+      if (!tissue_source(y, y, x, residual)) {
+        out.values[v] = 0;  // tissue left and none arrived
+        return;
+      }
+    }
+    const Eigen::Vector3d q = (to_index * x.homogeneous()).head<3>();
+    const int a = std::clamp(int(std::lround(q[0])), 0, labels.dims[0] - 1),
+              b = std::clamp(int(std::lround(q[1])), 0, labels.dims[1] - 1),
+              c = std::clamp(int(std::lround(q[2])), 0, labels.dims[2] - 1);
+    out.values[v] = labels.values[labels.linear_index(a, b, c)];
+  }, progress);
+  return out;
 }
 
 ImageVolume rasterise_elements(const LatticeField& field, const ImageVolume& grid, const std::vector<double>& values,

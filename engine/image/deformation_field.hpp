@@ -39,7 +39,6 @@ std::vector<float> forward_displacement_on_grid(const LatticeField& field, const
 
 struct WarpResult {
   ImageVolume warped;                 ///< the CT as it looks after the deformation
-  ImageVolume warped_labels;          ///< the label map carried along (nearest voxel), when given
   std::vector<float> inverse_field;   ///< d(y) = x − y with x + u(x) = y: resampling the input CT
                                       ///< at y + d(y) gives `warped` (ITK's resampling convention)
   double max_fixed_point_residual_m = 0;  ///< worst |x + u(x) − y| of the solved voxels (m)
@@ -55,10 +54,17 @@ struct WarpResult {
 /// smallest CT spacing and x lies in the model. Voxels outside the model that no tissue reaches
 /// keep their value; voxels tissue left take the CT's lowest value (air). u: n×3 (m, world).
 /// Slices are solved on all the host's cores; the result does not depend on their number.
-/// With `labels` (a label map on the CT grid), the same pull with the nearest voxel's label gives
-/// `warped_labels`; voxels tissue left take label 0.
 WarpResult warp_image(const ImageVolume& ct, const Lattice& lattice, const std::vector<double>& u,
-                      int iterations = 30, const ImageProgress& progress = {}, const ImageVolume* labels = nullptr);
+                      int iterations = 30, const ImageProgress& progress = {});
+
+/// A label map on the CT grid carried along by warp_image's pull: voxel y takes the label of the
+/// voxel nearest to its source y + d(y) (`inverse_field`, warp_image's); where d(y) is zero inside
+/// the model, the voxel's own fixed point is solved again as warp_image solved it, and a voxel
+/// tissue left (no solution) takes label 0; voxels outside the model keep their label. Done
+/// after the warp, so the warped CT need not be held with it. Slices on all cores.
+ImageVolume warp_labels(const ImageVolume& labels, const Lattice& lattice, const std::vector<double>& u,
+                        const std::vector<float>& inverse_field, int iterations = 30,
+                        const ImageProgress& progress = {});
 
 /// Per-element values rasterised on the grid: each voxel takes the value of the element
 /// containing its centre, `outside` elsewhere. values: n (one per element).

@@ -59,13 +59,18 @@ TEST(DeformationField, LabelsMoveWithTheTissue) {
   for (float& v : labels.values) v = v > -500.f ? 5.f : 0.f;
   std::vector<double> u(3 * s.lattice.element_count(), 0.0);
   for (std::size_t e = 0; e < s.lattice.element_count(); ++e) u[3 * e] = 0.003;  // 3 voxels along +x
-  const WarpResult w = warp_image(s.ct, s.lattice, u, 30, {}, &labels);
-  ASSERT_EQ(w.warped_labels.values.size(), labels.values.size());
-  EXPECT_EQ(w.warped_labels.values[labels.linear_index(32, 12, 9)], 5.f);  // tissue arrived
-  EXPECT_EQ(w.warped_labels.values[labels.linear_index(11, 12, 9)], 0.f);  // tissue left
+  const WarpResult w = warp_image(s.ct, s.lattice, u);
+  const ImageVolume warped = warp_labels(labels, s.lattice, u, w.inverse_field);
+  ASSERT_EQ(warped.values.size(), labels.values.size());
+  EXPECT_EQ(warped.values[labels.linear_index(32, 12, 9)], 5.f);  // tissue arrived
+  EXPECT_EQ(warped.values[labels.linear_index(11, 12, 9)], 0.f);  // tissue left
   std::size_t labelled = 0;
-  for (float v : w.warped_labels.values) labelled += v == 5.f;
+  for (float v : warped.values) labelled += v == 5.f;
   EXPECT_EQ(labelled, 20u * 16 * 12);
+  // Label by label where the CT is: every voxel the warped CT calls tissue is labelled 5, every
+  // vacated or air voxel 0 (the same pull, done again from the inverse field).
+  for (std::size_t v = 0; v < labels.values.size(); ++v)
+    ASSERT_EQ(warped.values[v] == 5.f, w.warped.values[v] > -500.f) << v;
 }
 
 /// A smooth non-rigid deformation (up to 1.5 mm): every solved voxel meets x + u(x) = y to the

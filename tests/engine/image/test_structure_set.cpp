@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include "engine/error.hpp"
 #include "engine/image/structure_set.hpp"
 
