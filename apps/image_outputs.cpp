@@ -1,5 +1,7 @@
 #include "apps/image_outputs.hpp"
 
+#include <malloc.h>
+
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -81,11 +83,19 @@ class Steps {
     close();
     return seconds_;
   }
+  /// The peak resident memory of each step so far (bytes, Linux).
+  const nlohmann::json& peak_bytes() const { return peak_bytes_; }
 
  private:
   void close() {
     const Clock::time_point now = Clock::now();
-    if (!what_.empty()) seconds_[what_] = seconds_.value(what_, 0.0) + std::chrono::duration<double>(now - start_).count();
+    if (!what_.empty()) {
+      seconds_[what_] = seconds_.value(what_, 0.0) + std::chrono::duration<double>(now - start_).count();
+      if (const std::optional<double> peak = process_memory_bytes("VmHWM"))
+        peak_bytes_[what_] = std::max(peak_bytes_.value(what_, 0.0), *peak);
+      overall_peak_ = std::max(overall_peak_, peak_bytes_.value(what_, 0.0));
+      reset_peak_memory();  // the next step's peak starts afresh
+    }
     what_.clear();
     start_ = now;
   }
@@ -93,7 +103,12 @@ class Steps {
   double total_, done_ = 0, weight_ = 0;
   std::string what_;
   Clock::time_point start_ = Clock::now();
-  nlohmann::json seconds_ = nlohmann::json::object();
+  nlohmann::json seconds_ = nlohmann::json::object(), peak_bytes_ = nlohmann::json::object();
+  double overall_peak_ = 0;
+
+ public:
+  /// The largest of the steps' peaks (0 where /proc is not there).
+  double overall_peak() const { return overall_peak_; }
 };
 
 }  // namespace
@@ -105,6 +120,10 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
   const ImageVolume& ct = *model.ct;
   const ImageVolume* labels = model.labels ? &*model.labels : nullptr;
   nlohmann::json written = nlohmann::json::object();
+  // Image-sized buffers (megabytes) are mapped and unmapped on their own: glibc's default raises
+  // its mmap threshold to 32 MiB after the first such buffer is freed, after which freed images
+  // stay in the heap and count as resident, and the next step's buffers add to them.
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
   const std::optional<double> memory_before = process_memory_bytes("VmRSS");
   reset_peak_memory();
   const LatticeField field(lattice, state.displacement_m);
@@ -116,7 +135,8 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
                             (want.fields ? 2 : 0));
   // Memory: besides the CT and its labels, at most the forward field (3 floats a voxel), or the
   // inverse field and the warped CT (3 + 1), or the inverse field and the warped labels (3 + 1)
-  // are held at once; every file is written from them in blocks.
+  // are held at once; every file is written from them in blocks (a few MiB in flight). The
+  // warped structures are contoured once the inverse field is gone.
   if (want.dvf) {
     const ImageProgress report = steps.step("forward DVF", 2);
     write_dvf(dir, "dvf", ct, forward_displacement_on_grid(field, ct, report), files, written);
@@ -142,9 +162,15 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
     std::vector<float>().swap(w.warped.values);  // written: the warped labels take its place
     written["warp_vacated_voxels"] = w.vacated_voxels;
     written["warp_max_inversion_residual_m"] = w.max_fixed_point_residual_m;
+    if (warped_series && files.dicom) {
+      steps.step("registration object", 0);
+      write_dicom_deformable_registration(dir + "/dvf_inverse.dcm", ct, w.inverse_field, ct, *warped_series);
+      written["dvf_inverse_dicom"] = "dvf_inverse.dcm";
+    }
     if (labels) {
       const ImageVolume warped_labels =
           warp_labels(*labels, lattice, state.displacement_m, w.inverse_field, 30, steps.step("warped labels", 1));
+      std::vector<float>().swap(w.inverse_field);  // the labels were its last use
       write_nifti(dir + "/warped_labels.nii.gz", warped_labels, NiftiType::Int16);
       written["warped_labels"] = "warped_labels.nii.gz";
       if (structures) {
@@ -152,11 +178,6 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
                        dir + "/warped_ct_dicom", "VoxBreast warped");
         written["warped_structures"] = "warped_structures.dcm";
       }
-    }
-    if (warped_series && files.dicom) {
-      steps.step("registration object", 0);
-      write_dicom_deformable_registration(dir + "/dvf_inverse.dcm", ct, w.inverse_field, ct, *warped_series);
-      written["dvf_inverse_dicom"] = "dvf_inverse.dcm";
     }
   }
   if (want.fields) {
@@ -179,10 +200,12 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
     written["fields"] = {"displacement_mm.nii.gz", "equivalent_strain.nii.gz", "von_mises_stress_pa.nii.gz"};
   }
   written["step_seconds"] = steps.seconds();
-  const std::optional<double> peak = process_memory_bytes("VmHWM");
-  if (memory_before && peak)
+  const std::optional<double> last = process_memory_bytes("VmHWM");
+  const double peak = std::max(steps.overall_peak(), last.value_or(0.0));
+  if (memory_before && peak > 0)
     written["host_memory"] = {{"before_bytes", *memory_before},
-                              {"peak_bytes", *peak},
+                              {"peak_bytes", peak},
+                              {"step_peak_bytes", steps.peak_bytes()},
                               {"ct_float_bytes", double(4 * ct.voxel_count())}};
   return written;
 }

@@ -16,7 +16,7 @@ namespace {
 
 /// Payload bytes per block: large enough that a fresh deflate dictionary per block costs little
 /// ratio, small enough that the blocks in flight (one per core) stay a few MB.
-constexpr std::size_t kBlockBytes = std::size_t(2) << 20;
+constexpr std::size_t kBlockBytes = std::size_t(1) << 20;
 
 struct Block {
   std::vector<unsigned char> raw, packed;
