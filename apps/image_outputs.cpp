@@ -1,6 +1,7 @@
 #include "apps/image_outputs.hpp"
 
 #include <malloc.h>
+#include <sys/resource.h>
 
 #include <chrono>
 #include <cmath>
@@ -58,6 +59,13 @@ std::optional<double> process_memory_bytes(const std::string& field) {
   return std::nullopt;
 }
 
+/// User + system CPU seconds of the process so far, all threads.
+double process_cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) + 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
 /// Starts the peak of resident memory afresh (Linux: "5" written to /proc/self/clear_refs).
 void reset_peak_memory() { std::ofstream("/proc/self/clear_refs") << "5"; }
 
@@ -83,6 +91,9 @@ class Steps {
     close();
     return seconds_;
   }
+  /// The CPU seconds (all threads, user + system) of each step so far: on a shared machine the
+  /// work a step takes, whatever share of the cores it got.
+  const nlohmann::json& cpu_seconds() const { return cpu_seconds_; }
   /// The peak resident memory of each step so far (bytes, Linux).
   const nlohmann::json& peak_bytes() const { return peak_bytes_; }
 
@@ -91,6 +102,9 @@ class Steps {
     const Clock::time_point now = Clock::now();
     if (!what_.empty()) {
       seconds_[what_] = seconds_.value(what_, 0.0) + std::chrono::duration<double>(now - start_).count();
+      const double cpu = process_cpu_seconds();
+      cpu_seconds_[what_] = cpu_seconds_.value(what_, 0.0) + (cpu - cpu_start_);
+      cpu_start_ = cpu;
       if (const std::optional<double> peak = process_memory_bytes("VmHWM"))
         peak_bytes_[what_] = std::max(peak_bytes_.value(what_, 0.0), *peak);
       overall_peak_ = std::max(overall_peak_, peak_bytes_.value(what_, 0.0));
@@ -103,7 +117,9 @@ class Steps {
   double total_, done_ = 0, weight_ = 0;
   std::string what_;
   Clock::time_point start_ = Clock::now();
-  nlohmann::json seconds_ = nlohmann::json::object(), peak_bytes_ = nlohmann::json::object();
+  nlohmann::json seconds_ = nlohmann::json::object(), cpu_seconds_ = nlohmann::json::object(),
+                 peak_bytes_ = nlohmann::json::object();
+  double cpu_start_ = process_cpu_seconds();
   double overall_peak_ = 0;
 
  public:
@@ -200,6 +216,7 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
     written["fields"] = {"displacement_mm.nii.gz", "equivalent_strain.nii.gz", "von_mises_stress_pa.nii.gz"};
   }
   written["step_seconds"] = steps.seconds();
+  written["step_cpu_seconds"] = steps.cpu_seconds();
   const std::optional<double> last = process_memory_bytes("VmHWM");
   const double peak = std::max(steps.overall_peak(), last.value_or(0.0));
   if (memory_before && peak > 0)

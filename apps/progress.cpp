@@ -62,7 +62,7 @@ void Progress::converge(double residual, double tolerance, const std::string& te
     if (rate > 0) left = (log_r - log_tol) / rate;
   }
   char head[96];
-  std::snprintf(head, sizeof head, "residual %.2e → %.0e  ", residual, tolerance);
+  std::snprintf(head, sizeof head, "%.2e → %.0e  ", residual, tolerance);
   draw(std::clamp(fraction, 0.0, 1.0), left, head + text);
 }
 

@@ -24,7 +24,8 @@ class Progress {
   void phase(const std::string& name);
   /// fraction of the phase done in [0, 1]; text is appended after the bar.
   void update(double fraction, const std::string& text);
-  /// A residual against its tolerance (both > 0); text is appended after the estimate.
+  /// A falling measure (a residual) against its tolerance (both > 0), shown as "R → TOL"; text
+  /// is appended after it.
   void converge(double residual, double tolerance, const std::string& text);
   void finish();
   /// Prints `line` (with its newline) to stdout above the bar, which is drawn again on the
