@@ -579,10 +579,6 @@ void set_text(char* field, std::size_t size, const std::string& text) {
   field[std::min(text.size(), size - 1)] = '\0';
 }
 
-/// zlib level of .nii.gz: the fastest. Image outputs are mostly constant background and smooth
-/// fields, which level 1 packs nearly as well as the default 6 in a fraction of the time.
-constexpr int kNiftiGzipLevel = 1;
-
 /// Header, extension flag, then the voxels, produced by fill(first voxel, count, out) in blocks
 /// on all cores and gzip-compressed for .nii.gz (write_blocks), into an atomic temporary file.
 template <class T, class Fill>
@@ -606,7 +602,7 @@ void write_file(const std::string& path, nifti_image& nim, Fill fill) {
                                                                            std::size_t size) {
       T* voxels = reinterpret_cast<T*>(bytes);  // offset and size are whole voxels (4-byte aligned blocks)
       fill(offset / sizeof(T), size / sizeof(T), voxels);
-    }, gzip, kNiftiGzipLevel);
+    }, gzip);
   } catch (...) {
     std::fclose(file);
     throw;
