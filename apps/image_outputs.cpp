@@ -33,10 +33,11 @@ std::vector<double> displacement_norm_mm(const FinalState& s) {
 
 /// A DVF as NIfTI (in the scene's layout) and as MetaImage; its statistics for summary.json.
 void write_dvf(const std::string& dir, const std::string& name, const ImageVolume& grid, const std::vector<float>& u,
-               const DvfFileOptions& files, nlohmann::json& written) {
+               const DvfFileOptions& files, nlohmann::json& written, const ImageProgress& progress) {
   write_nifti_displacement(dir + "/" + name + ".nii.gz", grid, u,
-                           files.legacy_nifti ? NiftiDisplacementLayout::VectorLps : NiftiDisplacementLayout::DispVectRas);
-  write_metaimage_displacement(dir + "/" + name + ".mha", grid, u);
+                           files.legacy_nifti ? NiftiDisplacementLayout::VectorLps : NiftiDisplacementLayout::DispVectRas,
+                           [&](double f) { progress(0.5 * f); });
+  write_metaimage_displacement(dir + "/" + name + ".mha", grid, u, [&](double f) { progress(0.5 + 0.5 * f); });
   written[name] = name + ".nii.gz";
   written[name + "_mha"] = name + ".mha";
   const DisplacementStats s = displacement_stats(u);
@@ -147,21 +148,23 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
   const bool warp = want.dvf || want.warped_ct || want.warped_ct_dicom;
   // Weights: rough shares of the time each step takes (the inverse solve dominates).
   const bool structures = labels && want.warped_ct_dicom;
-  Steps steps(progress, (want.dvf ? 2 : 0) + (warp ? 6 : 0) + (want.warped_ct_dicom ? 1 : 0) + (labels && warp ? 1 : 0) +
-                            (want.fields ? 2 : 0));
+  Steps steps(progress, (want.dvf ? 4 : 0) + (warp ? 4 : 0) + (want.warped_ct ? 0.5 : 0) +
+                            (want.warped_ct_dicom ? 1 : 0) + (labels && warp ? 1 : 0) + (want.fields ? 2 : 0));
   // Memory: besides the CT and its labels, at most the forward field (3 floats a voxel), or the
   // inverse field and the warped CT (3 + 1), or the inverse field and the warped labels (3 + 1)
   // are held at once; every file is written from them in blocks (a few MiB in flight). The
   // warped structures are contoured once the inverse field is gone.
   if (want.dvf) {
-    const ImageProgress report = steps.step("forward DVF", 2);
-    write_dvf(dir, "dvf", ct, forward_displacement_on_grid(field, ct, report), files, written);
+    const std::vector<float> u = forward_displacement_on_grid(field, ct, steps.step("forward DVF", 1));
+    write_dvf(dir, "dvf", ct, u, files, written, steps.step("writing dvf.nii.gz and dvf.mha", 1));
   }
   if (warp) {
-    WarpResult w = warp_image(ct, lattice, state.displacement_m, 30, steps.step("inverse DVF and warped CT", 6));
-    if (want.dvf) write_dvf(dir, "dvf_inverse", ct, w.inverse_field, files, written);
+    WarpResult w = warp_image(ct, lattice, state.displacement_m, 30, steps.step("inverse DVF and warped CT", 4));
+    if (want.dvf)
+      write_dvf(dir, "dvf_inverse", ct, w.inverse_field, files, written,
+                steps.step("writing dvf_inverse.nii.gz and dvf_inverse.mha", 2));
     if (want.warped_ct) {
-      write_nifti(dir + "/warped_ct.nii.gz", w.warped, NiftiType::Int16);
+      write_nifti(dir + "/warped_ct.nii.gz", w.warped, NiftiType::Int16, steps.step("writing warped_ct.nii.gz", 0.5));
       written["warped_ct"] = "warped_ct.nii.gz";
     }
     std::optional<WrittenDicomSeries> warped_series;
@@ -206,9 +209,9 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
         {"equivalent_strain.nii.gz", state.equivalent_strain},
         {"von_mises_stress_pa.nii.gz", state.von_mises_stress_pa}};
     for (std::size_t m = 0; m < maps.size(); ++m) {
+      const double n = double(maps.size());
       write_nifti(dir + "/" + maps[m].first, rasterise_elements(field, ct, maps[m].second, 0.f),
-                  m == 0 ? NiftiType::UInt8 : NiftiType::Float32);
-      report(double(m + 1) / double(maps.size()));
+                  m == 0 ? NiftiType::UInt8 : NiftiType::Float32, [&](double f) { report((double(m) + f) / n); });
     }
     nlohmann::json names = nlohmann::json::object();
     for (std::size_t t = 0; t < lattice.tissue_names.size(); ++t) names[std::to_string(t + 1)] = lattice.tissue_names[t];

@@ -49,7 +49,7 @@ void put_le32(std::vector<unsigned char>& out, std::uint32_t v) {
 }  // namespace
 
 bool write_blocks(std::FILE* file, const std::string& prefix, std::size_t payload_bytes, const FillBytes& fill,
-                  BlockCompression compression, int level) {
+                  BlockCompression compression, int level, const BlocksWritten& written) {
   const bool gzip = compression != BlockCompression::None, zlib = compression == BlockCompression::Zlib;
   const std::size_t total = prefix.size() + payload_bytes;
   const std::size_t block_count = std::max<std::size_t>(1, (total + kBlockBytes - 1) / kBlockBytes);
@@ -93,6 +93,7 @@ bool write_blocks(std::FILE* file, const std::string& prefix, std::size_t payloa
       if (zlib) crc = std::uint32_t(adler32_combine(crc, b.crc, z_off_t(b.raw.size())));
       else if (gzip) crc = std::uint32_t(crc32_combine(crc, b.crc, z_off_t(b.raw.size())));
     }
+    if (written) written(double(first + round) / double(block_count));
   }
   if (zlib) {
     const unsigned char trailer[4] = {static_cast<unsigned char>(crc >> 24), static_cast<unsigned char>(crc >> 16),

@@ -21,14 +21,19 @@ using FillBytes = std::function<void(std::size_t offset, unsigned char* out, std
 /// one zlib stream (RFC 1950: MetaImage's CompressedData).
 enum class BlockCompression { None, Gzip, Zlib };
 
+/// Told the fraction of the blocks written, in [0, 1], from the calling thread.
+using BlocksWritten = std::function<void(double fraction)>;
+
 /// Writes `prefix` followed by `payload_bytes` bytes from `fill` to `file`, compressed (prefix
-/// included) at zlib `level` as `compression` says. Returns false on a write error.
+/// included) at zlib `level` as `compression` says; `written` after each round of blocks.
+/// Returns false on a write error.
 bool write_blocks(std::FILE* file, const std::string& prefix, std::size_t payload_bytes, const FillBytes& fill,
-                  BlockCompression compression, int level = 6);
+                  BlockCompression compression, int level = 6, const BlocksWritten& written = {});
 /// The same, gzip-compressed when `gzip`.
 inline bool write_blocks(std::FILE* file, const std::string& prefix, std::size_t payload_bytes, const FillBytes& fill,
-                         bool gzip, int level = 6) {
-  return write_blocks(file, prefix, payload_bytes, fill, gzip ? BlockCompression::Gzip : BlockCompression::None, level);
+                         bool gzip, int level = 6, const BlocksWritten& written = {}) {
+  return write_blocks(file, prefix, payload_bytes, fill, gzip ? BlockCompression::Gzip : BlockCompression::None, level,
+                      written);
 }
 
 }  // namespace vb

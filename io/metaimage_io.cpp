@@ -71,7 +71,8 @@ std::string size_field(std::size_t bytes) {
 }  // namespace
 
 void write_metaimage_displacement(const std::string& path, const ImageVolume& grid,
-                                  const std::vector<float>& displacement_lps_m) {
+                                  const std::vector<float>& displacement_lps_m,
+                                  const std::function<void(double)>& progress) {
   require(path.size() > 4 && path.compare(path.size() - 4, 4, ".mha") == 0,
           "a MetaImage displacement field is written as one '.mha' file", path);
   require(displacement_lps_m.size() == kComponents * grid.voxel_count(),
@@ -100,7 +101,7 @@ void write_metaimage_displacement(const std::string& path, const ImageVolume& gr
              }
              *out++ = float(double(u) * 1e3);
            }
-         }, BlockCompression::Zlib, Z_BEST_SPEED);
+         }, BlockCompression::Zlib, Z_BEST_SPEED, progress);
     const long end = std::ftell(file);
     const std::string text = header(grid, size_field(std::size_t(end) - placeholder.size()), path);
     ok = ok && end > 0 && text.size() == placeholder.size() && std::fseek(file, 0, SEEK_SET) == 0 &&

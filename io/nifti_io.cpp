@@ -582,7 +582,7 @@ void set_text(char* field, std::size_t size, const std::string& text) {
 /// Header, extension flag, then the voxels, produced by fill(first voxel, count, out) in blocks
 /// on all cores and gzip-compressed for .nii.gz (write_blocks), into an atomic temporary file.
 template <class T, class Fill>
-void write_file(const std::string& path, nifti_image& nim, Fill fill) {
+void write_file(const std::string& path, nifti_image& nim, Fill fill, const BlocksWritten& progress) {
   const bool gzip = gzip_for(path);
   nim.iname_offset = kNifti1DataOffset;
   nifti_1_header header{};
@@ -602,7 +602,7 @@ void write_file(const std::string& path, nifti_image& nim, Fill fill) {
                                                                            std::size_t size) {
       T* voxels = reinterpret_cast<T*>(bytes);  // offset and size are whole voxels (4-byte aligned blocks)
       fill(offset / sizeof(T), size / sizeof(T), voxels);
-    }, gzip);
+    }, gzip, 6, progress);
   } catch (...) {
     std::fclose(file);
     throw;
@@ -654,7 +654,8 @@ ImageVolume read_nifti(const std::string& path) {
   });
 }
 
-void write_nifti(const std::string& path, const ImageVolume& image, NiftiType type) {
+void write_nifti(const std::string& path, const ImageVolume& image, NiftiType type,
+                 const std::function<void(double)>& progress) {
   require(image.values.size() == image.voxel_count(),
           "image has " + std::to_string(image.values.size()) + " values for " +
               std::to_string(image.voxel_count()) + " voxels",
@@ -669,12 +670,13 @@ void write_nifti(const std::string& path, const ImageVolume& image, NiftiType ty
     write_file<T>(path, *nim, [&](std::size_t first, std::size_t count, T* out) {
       for (std::size_t i = 0; i < count; ++i)
         out[i] = stored_value<T>(image.values[first + i], image.dims, first + i, path);
-    });
+    }, progress);
   });
 }
 
 void write_nifti_displacement(const std::string& path, const ImageVolume& grid,
-                              const std::vector<float>& displacement_lps_m, NiftiDisplacementLayout layout) {
+                              const std::vector<float>& displacement_lps_m, NiftiDisplacementLayout layout,
+                              const std::function<void(double)>& progress) {
   const std::size_t n = grid.voxel_count();
   require(displacement_lps_m.size() == kVectorComponents * n,
           "displacement has " + std::to_string(displacement_lps_m.size()) + " floats for " +
@@ -695,7 +697,7 @@ void write_nifti_displacement(const std::string& path, const ImageVolume& grid,
       require(std::isfinite(u), "displacement is not finite at " + voxel_name(grid.dims, i), path);
       out[f - first] = float((ras ? kLpsRasSign[c] : 1.0) * double(u) / kMetresPerMm);
     }
-  });
+  }, progress);
 }
 
 ImageVolume read_nifti_displacement(const std::string& path,
