@@ -37,13 +37,15 @@ int contour_slice(const std::vector<Eigen::Vector3d>& contour, std::size_t numbe
   points.clear();
   double k_min = INFINITY, k_max = -INFINITY;
   for (const Eigen::Vector3d& p : contour) {
-    require(p.allFinite(), which + " has a point that is not a finite number", roi_where(roi));
+    // Per point: messages are built only on failure.
+    if (!p.allFinite()) throw Error(which + " has a point that is not a finite number", roi_where(roi));
     const Eigen::Vector3d q = (to_index * p.homogeneous()).head<3>();
     const bool inside = q.x() >= -kEdgeMarginVoxels && q.x() <= grid.dims[0] - 1 + kEdgeMarginVoxels &&
                         q.y() >= -kEdgeMarginVoxels && q.y() <= grid.dims[1] - 1 + kEdgeMarginVoxels &&
                         q.z() >= -kEdgeMarginVoxels && q.z() <= grid.dims[2] - 1 + kEdgeMarginVoxels;
-    require(inside, which + " lies outside the image: point " + mm_point(p) + " is beyond the CT's edge",
-            roi_where(roi), "the structures must be drawn on this CT");
+    if (!inside)
+      throw Error(which + " lies outside the image: point " + mm_point(p) + " is beyond the CT's edge",
+                  roi_where(roi), "the structures must be drawn on this CT");
     k_min = std::min(k_min, q.z());
     k_max = std::max(k_max, q.z());
     points.emplace_back(q.x(), q.y());
