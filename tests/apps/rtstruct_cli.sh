@@ -65,6 +65,10 @@ PY
 then pass "pydicom reads the phantom's structures and their references"; else fail "pydicom phantom"; fi
 if plastimatch_agrees "$work/ph/rtstruct.dcm" "$work/ph/dicom" "$work/ph/labels.nii.gz" "$names"; then
   pass "plastimatch convert rasterises the phantom's contours to its label map"; else fail "plastimatch phantom"; fi
+# Deterministic like the series: the same phantom gives the same bytes, UIDs included.
+if "$bin" phantom --out "$work/ph_again" --spacing 4 --tumour idc,15,-25,10,8 >/dev/null 2>&1 \
+   && cmp -s "$work/ph/rtstruct.dcm" "$work/ph_again/rtstruct.dcm"; then
+  pass "the phantom's rtstruct.dcm is byte-identical on a rerun"; else fail "phantom rtstruct determinism"; fi
 
 # The structures instead of the label map: the same model; the outputs carry them. The CT is the
 # DICOM series, so the structures' frame of reference is checked against the CT's.
