@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "engine/error.hpp"
-#include "engine/sim/parallel_chunks.hpp"
+#include "engine/image/parallel_items.hpp"
 
 namespace vb {
 namespace {

@@ -8,7 +8,7 @@
 #include <tuple>
 
 #include "engine/error.hpp"
-#include "engine/sim/parallel_chunks.hpp"
+#include "engine/image/parallel_items.hpp"
 
 namespace vb {
 

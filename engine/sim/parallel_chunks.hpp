@@ -4,7 +4,6 @@
 /// elements on one core, 48 ms for a fit's batch of nine copies; docs/FIT.md). Results must not
 /// depend on the split: per-element outputs, or reductions (max) that are exact in any order.
 #include <algorithm>
-#include <atomic>
 #include <cstddef>
 #include <system_error>
 #include <thread>
@@ -39,22 +38,6 @@ void for_chunks(std::size_t n, std::size_t chunks, Fn fn) {
   }
   fn(std::size_t(0), range(0).first, range(0).second);
   for (std::thread& t : threads) t.join();
-}
-
-/// Calls fn(index) for every index of [0, n), one core per thread, each thread taking the next
-/// index as it finishes one (items of uneven cost, such as image slices, balance out). After each
-/// of its items the calling thread calls on_done(items finished so far): progress reports come
-/// from one thread only. fn must not throw; it must not depend on which thread runs it.
-template <class Fn, class Done>
-void for_each_index_dynamic(std::size_t n, Fn fn, Done on_done) {
-  std::atomic<std::size_t> next{0}, finished{0};
-  for_chunks(n, chunk_count(n, 1), [&](std::size_t chunk, std::size_t, std::size_t) {
-    for (std::size_t i = next++; i < n; i = next++) {
-      fn(i);
-      const std::size_t done = ++finished;
-      if (chunk == 0) on_done(done);
-    }
-  });
 }
 
 }  // namespace vb
