@@ -110,19 +110,24 @@ class Seeds {
       : ct_(ct), reach_(reach), block_(std::max(1, reach)) {
     for (int a = 0; a < 3; ++a) blocks_[a] = (ct.dims[a] + block_ - 1) / block_;
     const Eigen::Matrix4d to_index = ct.affine_lps_m.inverse();
-    std::vector<std::pair<std::size_t, Entry>> placed;  // (block, entry)
-    for (std::size_t e = 0; e < lattice.element_count(); ++e) {
+    // The voxel element e landed in, if inside the CT.
+    const auto landed = [&](std::size_t e, std::array<int, 3>& v) {
       const Eigen::Vector3d y = lattice.rest_position(e) + Eigen::Vector3d(u[3 * e], u[3 * e + 1], u[3 * e + 2]);
       const Eigen::Vector3d q = (to_index * y.homogeneous()).head<3>();
-      const int i = int(std::lround(q[0])), j = int(std::lround(q[1])), k = int(std::lround(q[2]));
-      if (i < 0 || j < 0 || k < 0 || i >= ct.dims[0] || j >= ct.dims[1] || k >= ct.dims[2]) continue;
-      placed.push_back({block_of(i / block_, j / block_, k / block_), Entry{{i, j, k}, std::int64_t(e)}});
-    }
-    std::stable_sort(placed.begin(), placed.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
+      for (int a = 0; a < 3; ++a) v[std::size_t(a)] = int(std::lround(q[a]));
+      return v[0] >= 0 && v[1] >= 0 && v[2] >= 0 && v[0] < ct.dims[0] && v[1] < ct.dims[1] && v[2] < ct.dims[2];
+    };
+    // A counting sort by block in two passes (count, then place): entries in element order within
+    // each block, and nothing held per element beyond the entries themselves.
     start_.assign(std::size_t(blocks_[0]) * blocks_[1] * blocks_[2] + 1, 0);
-    for (const auto& [block, entry] : placed) ++start_[block + 1];
+    std::array<int, 3> v{};
+    for (std::size_t e = 0; e < lattice.element_count(); ++e)
+      if (landed(e, v)) ++start_[block_of(v[0] / block_, v[1] / block_, v[2] / block_) + 1];
     for (std::size_t b = 1; b < start_.size(); ++b) start_[b] += start_[b - 1];
-    for (const auto& [block, entry] : placed) entries_.push_back(entry);
+    entries_.resize(start_.back());
+    std::vector<std::size_t> next(start_.begin(), start_.end() - 1);
+    for (std::size_t e = 0; e < lattice.element_count(); ++e)
+      if (landed(e, v)) entries_[next[block_of(v[0] / block_, v[1] / block_, v[2] / block_)]++] = Entry{v, std::int64_t(e)};
   }
 
   /// The elements that landed within `reach` voxels of (i, j, k) along each axis, nearest (in
