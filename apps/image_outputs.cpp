@@ -146,13 +146,13 @@ nlohmann::json write_image_outputs(const std::string& dir, const Scene& scene, c
   const LatticeField field(lattice, state.displacement_m);
   const DvfFileOptions files = dvf_file_options(scene);
   const bool warp = want.dvf || want.warped_ct || want.warped_ct_dicom;
-  // Weights: rough shares of the time each step takes (the inverse solve dominates).
+  // Weights: rough shares of the time each step takes on a CPU (clinical-size CT, docs/BENCHMARKS.md).
   const bool structures = labels && want.warped_ct_dicom;
   Steps steps(progress, (want.dvf ? 4 : 0) + (warp ? 4 : 0) + (want.warped_ct ? 0.5 : 0) +
                             (want.warped_ct_dicom ? 1 : 0) + (labels && warp ? 1 : 0) + (want.fields ? 2 : 0));
   // Memory: besides the CT and its labels, at most the forward field (3 floats a voxel), or the
   // inverse field and the warped CT (3 + 1), or the inverse field and the warped labels (3 + 1)
-  // are held at once; every file is written from them in blocks (a few MiB in flight). The
+  // are held at once; every file is written from them in blocks (about a MiB in flight). The
   // warped structures are contoured once the inverse field is gone.
   if (want.dvf) {
     const std::vector<float> u = forward_displacement_on_grid(field, ct, steps.step("forward DVF", 1));
