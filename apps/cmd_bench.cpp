@@ -10,12 +10,15 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <set>
 
 #include "apps/bench_throughput.hpp"
 #include "apps/commands.hpp"
+#include "apps/progress.hpp"
+#include "apps/simulation_pipeline.hpp"
 #include "engine/bench/bench_knobs.hpp"
 #include "engine/bench/bench_table.hpp"
 #include "engine/bench/standard_study.hpp"
@@ -44,6 +47,7 @@ struct BenchOptions {
   std::vector<int> haptic_elements = {10000};  ///< haptic-rate blocks (about this many elements)
   double haptic_seconds = 3;
   std::vector<std::string> laws, integrators, scenes;
+  std::vector<std::string> jobs;  ///< scenes run end to end like `simulate`, each phase timed
 };
 
 std::string utc_date() {
@@ -115,6 +119,47 @@ nlohmann::json run_haptic_bench(const ClContext& cl, const BenchOptions& o) {
   return rows;
 }
 
+/// The main job end to end (`voxbreast simulate`) on each --job scene, into OUT/job_N/: the time
+/// of each phase (summary.json `timings`) and the image outputs' peak host memory over the CT's
+/// size as floats.
+nlohmann::json run_job_bench(const ClContext& cl, const BenchOptions& o) {
+  nlohmann::json rows = nlohmann::json::array();
+  Progress bar(true);
+  for (std::size_t n = 0; n < o.jobs.size(); ++n) {
+    const auto command_start = std::chrono::steady_clock::now();
+    const Scene scene = load_scene(o.jobs[n], "");
+    const std::string dir = o.out + "/job_" + std::to_string(n + 1);
+    const OutputDir job_dir(dir);
+    SimulationOptions options;
+    options.command_start = command_start;
+    show_progress(bar, scene, options, "job " + std::to_string(n + 1) + " ");
+    const SimulationReport report = simulate_scene(scene, cl, dir, options);
+    bar.finish();
+    const nlohmann::json summary = nlohmann::json::parse(std::ifstream(dir + "/summary.json"));
+    const PhaseTimings& t = report.timings;
+    nlohmann::json row = {{"scene", o.jobs[n]}, {"elements", report.summary.elements},
+                          {"steps", report.summary.steps}, {"converged", report.summary.converged},
+                          {"timings", summary.at("timings")}};
+    double memory_ratio = NAN;
+    if (summary.contains("image_outputs") && summary["image_outputs"].contains("host_memory")) {
+      const nlohmann::json& m = summary["image_outputs"]["host_memory"];
+      memory_ratio = (m.at("peak_bytes").get<double>() - m.at("before_bytes").get<double>()) /
+                     m.at("ct_float_bytes").get<double>();
+      row["ct_voxels"] = m.at("ct_float_bytes").get<double>() / 4;
+      row["image_outputs_peak_memory_over_ct_floats"] = memory_ratio;
+    }
+    std::printf("job %zu %s: %zu el, %lld steps; setup %.1f s, kernel build %.1f s, reference state %.1f s, solve %.1f s, "
+                "reproducibility %.1f s, outputs %.1f s (image outputs %.1f s, peak memory %.2f × the CT's floats); "
+                "total %.1f s\n",
+                n + 1, o.jobs[n].c_str(), report.summary.elements, (long long)report.summary.steps, t.setup_s,
+                t.kernel_build_s, t.reference_state_s, t.solve_s, t.reproducibility_s, t.outputs_s, t.image_outputs_s,
+                memory_ratio, t.total_s);
+    std::fflush(stdout);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
 int run_bench(BenchOptions o) {
   const auto start = std::chrono::steady_clock::now();
   const OutputDir output_dir(o.out);
@@ -137,6 +182,11 @@ int run_bench(BenchOptions o) {
     if (!o.no_study) write_text_atomically(o.out + "/bench.csv", study_csv);
   };
   std::unique_ptr<ClContext> cl;
+  if (!o.dry_run && !o.jobs.empty()) {
+    cl = std::make_unique<ClContext>(device);
+    doc["jobs"] = run_job_bench(*cl, o);
+    write_outputs();
+  }
   // The cubes first: they are short, and kept when a long study is cut off by a time limit.
   if (!o.dry_run && o.haptic) {
     if (!cl) cl = std::make_unique<ClContext>(device);
@@ -144,7 +194,7 @@ int run_bench(BenchOptions o) {
     write_outputs();
   }
   const bool breast_any = o.breast || o.breast_large || !o.breast_elements.empty();
-  if (!o.dry_run && (!o.sizes.empty() || breast_any || (!o.quick && o.no_study && !o.haptic))) {
+  if (!o.dry_run && (!o.sizes.empty() || breast_any || (!o.quick && o.no_study && !o.haptic && o.jobs.empty()))) {
     if (!cl) cl = std::make_unique<ClContext>(device);
     ThroughputOptions t;
     // 35,937 and 1,520,875 elements unless sizes are given; --breast alone times the breast alone
@@ -256,6 +306,10 @@ Command add_bench(CLI::App& app) {
                                          "enqueue time, the device's time alone, the timed step) and the device time "
                                          "and launches per step of each kernel (a second run of each block on a "
                                          "profiling queue)");
+  sub->add_option("--job", o->jobs,
+                  "run this scene end to end like 'simulate' (into OUT/job_N/), timing each phase and the image "
+                  "outputs' peak memory; repeatable")
+      ->check(CLI::ExistingFile);
   sub->add_flag("--dry-run", o->dry_run, "list the scenes and cases without running them");
   sub->add_flag("--haptic", o->haptic, "haptic rate: a probe pressing a block, force output at 1 kHz (with "
                                        "--no-study: only this)");

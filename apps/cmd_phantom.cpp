@@ -1,16 +1,22 @@
-// voxbreast phantom --out DIR [--seed N] [--tumour type,x,y,z,r] — a synthetic supine breast CT
-// (NIfTI + DICOM), its label map, and a ready-to-run scene that simulates it prone.
+// voxbreast phantom --out DIR [--seed N] [--tumour type,x,y,z,r] [--spacing MM...] [--dims NX NY NZ]
+// — a synthetic supine breast CT (NIfTI + DICOM), its label map, and a ready-to-run scene that
+// simulates it prone.
 //   voxbreast phantom --out out/phantom --seed 7 --tumour idc,15,-25,10,8
+//   voxbreast phantom --out out/planning --spacing 0.98 0.98 2.5 --dims 512 512 200
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <sstream>
 
 #include "apps/commands.hpp"
+#include "engine/error.hpp"
 #include "engine/image/breast_phantom.hpp"
 #include "engine/loads/posture.hpp"
 #include "io/atomic_file.hpp"
 #include "io/dicom_io.hpp"
+#include "engine/image/structure_set.hpp"
 #include "io/nifti_io.hpp"
+#include "io/rtstruct.hpp"
 #include "io/run_folder.hpp"
 
 namespace vb::app {
@@ -19,7 +25,8 @@ namespace {
 struct PhantomOptions {
   std::string out;
   std::uint64_t seed = 1;
-  double spacing_mm = 2.0;
+  std::vector<double> spacing_mm = {2.0};  ///< one edge, or x, y, z
+  std::vector<int> dims;                    ///< empty, or voxels along x, y, z
   std::vector<std::string> tumours;
 };
 
@@ -47,11 +54,16 @@ std::string phantom_scene(const Phantom& p, const PhantomSpec& spec) {
 }
 
 int run_phantom(const PhantomOptions& o) {
-  RunFolder folder(o.out, "phantom", {"ct.nii.gz", "labels.nii.gz", "dicom", "scene.toml"});
+  RunFolder folder(o.out, "phantom", {"ct.nii.gz", "labels.nii.gz", "dicom", "rtstruct.dcm", "scene.toml"});
   check_dicom_series_replaceable(o.out + "/dicom");  // refuse before any file is replaced
   PhantomSpec spec;
   spec.seed = o.seed;
-  spec.spacing_m = o.spacing_mm * 1e-3;
+  require(o.spacing_mm.size() == 1 || o.spacing_mm.size() == 3,
+          "--spacing takes one voxel size or three (x, y, z), got " + std::to_string(o.spacing_mm.size()),
+          "phantom --spacing");
+  if (o.spacing_mm.size() == 1) spec.spacing_m = o.spacing_mm[0] * 1e-3;
+  else spec.spacing_xyz_m = 1e-3 * Eigen::Vector3d(o.spacing_mm[0], o.spacing_mm[1], o.spacing_mm[2]);
+  if (!o.dims.empty()) spec.dims = {o.dims[0], o.dims[1], o.dims[2]};
   for (const std::string& t : o.tumours) spec.tumours.push_back(parse_tumour_option(t));
   const Phantom p = make_breast_phantom(spec);
   const std::string& dir = folder.staging();
@@ -62,10 +74,18 @@ int run_phantom(const PhantomOptions& o) {
   series.patient_position = dicom_patient_position(gravity_for_posture("supine"));  // the phantom lies supine
   series.deterministic = true;  // the same phantom always gives the same files, UIDs included
   replace_dicom_series(dir + "/dicom", p.ct, series);
+  // The label map as structures on the DICOM series: one ROI per tissue present.
+  std::map<int, std::string> present;
+  for (const float v : p.labels.values)
+    if (v > 0 && !present.count(int(v))) present[int(v)] = p.label_names[std::size_t(v)];
+  write_rtstruct(dir + "/rtstruct.dcm", structures_of_labels(p.labels, present), dir + "/dicom", "VoxBreast phantom",
+                 /*deterministic=*/true);
   write_text_atomically(dir + "/scene.toml", phantom_scene(p, spec));
   folder.commit();
-  std::printf("phantom %d × %d × %d voxels of %.1f mm, seed %llu\nwrote %s/ct.nii.gz, labels.nii.gz, dicom/, scene.toml\n",
-              p.ct.dims[0], p.ct.dims[1], p.ct.dims[2], o.spacing_mm, (unsigned long long)o.seed, o.out.c_str());
+  const Eigen::Vector3d h_mm = 1e3 * p.ct.spacing_m();
+  std::printf("phantom %d × %d × %d voxels of %.4g × %.4g × %.4g mm, seed %llu\nwrote %s/ct.nii.gz, labels.nii.gz, dicom/, rtstruct.dcm, scene.toml\n",
+              p.ct.dims[0], p.ct.dims[1], p.ct.dims[2], h_mm.x(), h_mm.y(), h_mm.z(), (unsigned long long)o.seed,
+              o.out.c_str());
   return 0;
 }
 
@@ -76,7 +96,12 @@ Command add_phantom(CLI::App& app) {
   auto* sub = app.add_subcommand("phantom", "Write a synthetic breast CT (NIfTI + DICOM), labels and a scene");
   sub->add_option("--out,-o", o->out, "output folder")->required();
   sub->add_option("--seed", o->seed, "random seed of the glandular texture and noise (default 1)");
-  sub->add_option("--spacing", o->spacing_mm, "voxel size in mm (default 2)")->check(CLI::Range(0.25, 10.0));
+  sub->add_option("--spacing", o->spacing_mm, "voxel size in mm, one for all axes or x y z (default 2)")
+      ->expected(1, 3)
+      ->check(CLI::Range(0.25, 10.0));
+  sub->add_option("--dims", o->dims, "voxels along x y z (default: the phantom with a margin of air)")
+      ->expected(3)
+      ->check(CLI::Range(1, 4096));
   sub->add_option("--tumour", o->tumours, "type,x,y,z,radius in mm (type: idc, dcis, fibroadenoma); repeatable");
   return {sub, [o] { return run_phantom(*o); }};
 }

@@ -1,5 +1,6 @@
 // voxbreast simulate SCENE.toml --out DIR — runs a scene and writes summary.json, metrics.csv and result.h5.
 //   voxbreast simulate data-samples/breast_phantom.toml --out out/phantom
+#include <chrono>
 #include <cstdio>
 #include <memory>
 
@@ -18,9 +19,11 @@ struct SimulateOptions {
   std::string scene, out, device, precision, series;
   std::vector<std::string> settings;  ///< --set KEY=VALUE
   bool quiet = false, allow_gaps = false;
+  double status_interval_s = 10;
 };
 
 int run_simulate(const SimulateOptions& o) {
+  const auto command_start = std::chrono::steady_clock::now();
   std::vector<SceneOverride> overrides;  // --set values, applied to the scene's text
   for (const std::string& s : o.settings) overrides.push_back(parse_scene_setting(s));
   Scene scene = overrides.empty() ? load_scene(o.scene, o.precision) : parse_scene_file(o.scene, overrides);
@@ -31,30 +34,19 @@ int run_simulate(const SimulateOptions& o) {
   // Fails before computing, not after; the run writes into its staging folder until commit().
   RunFolder folder(o.out, "simulate", {"summary.json", "metrics.csv", "result.h5"});
   const ClContext cl(select_device(o.device));
-  Progress bar(!o.quiet);
+  Progress bar(!o.quiet, o.status_interval_s);
   SimulationOptions options;
-  options.on_start = [&](const PreparedModel& model, const Simulator& sim) {
-    if (!o.quiet)
-      std::fprintf(stderr, "voxbreast: %zu elements, %zu connections, dt = %.3g s (%s), device %s, %s\n",
-                   model.lattice.element_count(), model.lattice.connection_count, sim.dt_s(),
-                   sim.time_step().automatic ? "auto" : "given", cl.info.name.c_str(),
-                   scene.solver.precision == Precision::Double ? "double" : "float");
-  };
-  options.on_progress = [&](const RunProgress& p) {
-    char text[160];
-    std::snprintf(text, sizeof text, "step %lld  t=%.4g s  residual %.2e  speed %.2e", (long long)p.step, p.time_s,
-                  p.residual, p.speed_ratio);
-    bar.update(double(p.step) / double(p.max_steps), text);
-  };
+  options.command_start = command_start;
+  show_progress(bar, scene, options);
   options.on_reference_iteration = [&](const ReferenceIteration& r) {
     if (o.quiet) return;
-    bar.finish();
+    bar.phase("reference state");
     std::fprintf(stderr, "voxbreast: unloaded state, iteration %d (step %.3g): lands %.4f mm from the CT (rms %.4f mm, %lld steps)\n",
                  r.iteration, r.step, 1e3 * r.residual_max_m, 1e3 * r.residual_rms_m, (long long)r.steps);
   };
   options.on_perturbed_run = [&](const PerturbedRun& r) {
     if (o.quiet) return;
-    bar.finish();
+    bar.phase("reproducibility");
     std::fprintf(stderr, "voxbreast: posture %d/%d %s device (roll %.2f, pitch %.2f, yaw %.2f deg): tumour at (%.2f, %.2f, %.2f) mm%s\n",
                  r.index, scene.reproducibility.perturbations, r.device ? "with" : "without", r.rpy_deg.x(),
                  r.rpy_deg.y(), r.rpy_deg.z(), 1e3 * r.tumour_centroid_m.x(), 1e3 * r.tumour_centroid_m.y(),
@@ -125,6 +117,9 @@ Command add_simulate(CLI::App& app) {
   sub->add_option("--series", o->series, "DICOM SeriesInstanceUID when the CT folder holds several series");
   sub->add_flag("--allow-gaps", o->allow_gaps, "accept unevenly spaced DICOM slices (with a warning)");
   sub->add_flag("--quiet,-q", o->quiet, "no progress display");
+  sub->add_option("--status-interval", o->status_interval_s,
+                  "seconds between status lines on stderr when it is not a terminal (default 10)")
+      ->check(CLI::PositiveNumber);
   return {sub, [o] { return run_simulate(*o); }};
 }
 

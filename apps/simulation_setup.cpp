@@ -3,14 +3,18 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "engine/error.hpp"
 #include "engine/image/image_lattice.hpp"
+#include "engine/image/structure_set.hpp"
 #include "engine/lattice/voxelise.hpp"
 #include "engine/sim/element_mass.hpp"
 #include "engine/sim/device_memory.hpp"
 #include "engine/sim/simulator.hpp"
 #include "io/dicom_io.hpp"
 #include "io/nifti_io.hpp"
+#include "io/rtstruct.hpp"
 #include "io/scene_file.hpp"
+#include "io/scene_structures.hpp"
 
 namespace vb::app {
 
@@ -77,6 +81,31 @@ void warn_lumped_mass(const Scene& scene, const Lattice& lattice, const ElementA
   }
 }
 
+/// model.structures rasterised on the CT: each ROI the table maps to a tissue gets a label value
+/// (1, 2, … in the file's order), which model.label_table maps to its tissue; names: value → ROI.
+ImageVolume structure_labels(const StructureSpec& structures, const ImageVolume& ct, ModelSpec& model,
+                             std::map<int, std::string>& names) {
+  const StructureSet set = read_rtstruct(structures.path);
+  StructureLabelRule rule;
+  rule.priority = structures.priority;
+  for (const StructureRoi& roi : set.rois) {
+    const auto tissue = structures.table.find(roi.name);
+    if (tissue == structures.table.end()) continue;  // rasterise_structures names it
+    if (tissue->second == "ignore") {
+      rule.labels[roi.name] = 0;
+      continue;
+    }
+    const int value = int(names.size()) + 1;
+    rule.labels[roi.name] = value;
+    names[value] = roi.name;
+    model.label_table[value] = tissue->second;
+  }
+  for (const auto& [roi, tissue] : structures.table)
+    require(rule.labels.count(roi), "the structure table names ROI '" + roi + "', which the RTSTRUCT does not hold",
+            structures.path, "check the ROI names in the file");
+  return rasterise_structures(set, ct, rule);
+}
+
 }  // namespace
 
 PreparedModel prepare_model(const Scene& scene, const DeviceInfo* device) {
@@ -89,10 +118,15 @@ PreparedModel prepare_model(const Scene& scene, const DeviceInfo* device) {
   }
   if (scene.model.from_image()) {
     m.ct = load_ct(scene.model, m.warnings);
-    std::optional<ImageVolume> labels;
-    if (!scene.model.labels_path.empty()) labels = read_nifti(scene.model.labels_path);
-    const TissueMap map = classify_image(scene.model, *m.ct, labels ? &*labels : nullptr);
-    m.lattice = build_lattice(lattice_volume_from_image(scene.model, *m.ct, map, scene.solver.precision, budget),
+    ModelSpec model = scene.model;
+    if (!model.labels_path.empty()) {
+      m.labels = read_nifti(model.labels_path);
+      m.label_names = model.label_table;
+    } else if (const StructureSpec structures = scene_structures(scene); !structures.path.empty()) {
+      m.labels = structure_labels(structures, *m.ct, model, m.label_names);
+    }
+    const TissueMap map = classify_image(model, *m.ct, m.labels ? &*m.labels : nullptr);
+    m.lattice = build_lattice(lattice_volume_from_image(model, *m.ct, map, scene.solver.precision, budget),
                               scene.model.downsample);
   } else {
     m.lattice = build_lattice(voxelise_shapes(scene, budget), scene.model.downsample);

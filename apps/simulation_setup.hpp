@@ -1,5 +1,6 @@
 #pragma once
 /// Scene → model steps shared by the subcommands.
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,6 +20,10 @@ struct PreparedModel {
   Lattice lattice;
   ElementArrays elements;
   std::optional<ImageVolume> ct;      ///< the input CT, for image models
+  /// The CT's label map (model.labels, or model.structures rasterised), when the model has one,
+  /// and each label value's name (the ROI's name for structures, else the tissue's).
+  std::optional<ImageVolume> labels;
+  std::map<int, std::string> label_names;
   std::vector<std::string> warnings;  ///< e.g. DICOM slice gaps accepted with allow_gaps
 };
 

@@ -30,6 +30,11 @@ constexpr const char* kSourceSopClassKey = "source_sop_class_uid";
 constexpr const char* kSourceInstancesKey = "source_instance_uids";
 constexpr const char* kCorruptFileHint = "the file may be truncated or corrupt; remove or replace it";
 
+/// A DICOM UID under the 2.25 root made from `name` (a name-based, SHA-1, version 5 UUID in
+/// VoxBreast's own namespace, PS3.5 B.2): the same name always gives the same UID, so files
+/// written from the same content are byte-identical.
+std::string name_based_uid(const std::string& name);
+
 /// "gggg,eeee" in upper-case hex, as the standard prints tags.
 std::string tag_key_text(const DcmTagKey& key);
 std::optional<DcmTagKey> parse_tag_key(const std::string& text);

@@ -3,6 +3,8 @@
 #include <dcmtk/config/osconfig.h>  // DCMTK: must come before its other headers
 #include <dcmtk/dcmdata/dcdeftag.h>
 #include <dcmtk/dcmdata/dcfilefo.h>
+#include <dcmtk/dcmdata/dcistrmf.h>
+#include <dcmtk/dcmdata/dcvrfl.h>
 #include <dcmtk/dcmdata/dcuid.h>
 #include <dcmtk/dcmdata/dcvrda.h>
 #include <dcmtk/dcmdata/dcvrtm.h>
@@ -13,6 +15,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -32,6 +35,7 @@ namespace fs = std::filesystem;
 
 namespace vb {
 using namespace dicom;
+
 namespace {
 
 /// Slice grid of a volume in DICOM terms (mm, LPS).
@@ -151,24 +155,6 @@ std::string content_digest(const ImageVolume& ct, const std::string& description
   return sha.finish();
 }
 
-/// A name-based (SHA-1, version 5) UUID of `name` as a DICOM UID under the 2.25 root
-/// (PS3.5 B.2): the same name always gives the same UID.
-std::string name_based_uid(const std::string& name) {
-  // RFC 4122 version 5 in VoxBreast's own namespace (a fixed random UUID).
-  static const unsigned char kNamespace[16] = {0x3c, 0x8e, 0x52, 0x0b, 0x9d, 0x41, 0x4f, 0x6a,
-                                               0xa7, 0x1e, 0x0c, 0x55, 0xd2, 0x93, 0x68, 0xf4};
-  Digest sha1(EVP_sha1());
-  sha1.add(kNamespace, sizeof kNamespace);
-  sha1.add(name.data(), name.size());
-  const std::string digest = sha1.finish();
-  OFUUID::BinaryRepresentation bytes;
-  std::copy(digest.begin(), digest.begin() + 16, bytes.value);
-  bytes.value[6] = Uint8((bytes.value[6] & 0x0f) | 0x50);  // version 5
-  bytes.value[8] = Uint8((bytes.value[8] & 0x3f) | 0x80);  // RFC 4122 variant
-  OFString text;
-  return OFUUID(bytes).toString(text, OFUUID::ER_RepresentationOID).c_str();
-}
-
 /// Fresh UIDs, or (deterministic) UIDs named after the volume's content and the UID's role.
 class UidSource {
  public:
@@ -243,6 +229,16 @@ class DatasetWriter {
   }
   void floats(const DcmTagKey& key, const std::vector<Float32>& values) {
     check(data_.putAndInsertFloat32Array(key, values.data(), values.size()), key);
+  }
+  /// An FL attribute whose `bytes` (little-endian floats) DCMTK reads from `file` only while it
+  /// writes the dataset: a large value is never held in memory.
+  void floats_from_file(const DcmTagKey& key, const std::string& file, std::size_t bytes) {
+    require(bytes % 4 == 0 && bytes < 0xFFFFFFFEu, "the attribute is too large for DICOM", path_);
+    auto* element = new DcmFloatingPointSingle(DcmTag(key));
+    check(element->createValueFromTempFile(new DcmInputFileStreamFactory(file.c_str(), 0), Uint32(bytes),
+                                           EBO_LittleEndian),
+          key);
+    check(data_.insert(element, /*replaceOld=*/true), key);
   }
   /// Sequence `key` with no items (a type 2 sequence with nothing to say).
   void empty_sequence(const DcmTagKey& key) { check(data_.insertEmptyElement(key), key); }
@@ -595,9 +591,30 @@ void write_dicom_deformable_registration(const std::string& path, const ImageVol
   put_grid.text(DCM_ImageOrientationPatient, ds_list(cosines));
   put_grid.longs(DCM_GridDimensions, {Uint32(grid.dims[0]), Uint32(grid.dims[1]), Uint32(grid.dims[2])});
   put_grid.doubles(DCM_GridResolution, {g.column_spacing_mm, g.row_spacing_mm, g.slice_step_mm.norm()});
-  std::vector<Float32> vectors_mm(displacement_lps_m.size());
-  for (std::size_t n = 0; n < vectors_mm.size(); ++n) vectors_mm[n] = Float32(1e3 * double(displacement_lps_m[n]));
-  put_grid.floats(DCM_VectorGridData, vectors_mm);
+  // The vectors in mm go to a temporary file beside `path` in blocks, and DCMTK copies them from
+  // there into the file it writes: no second copy of the field is held (it is 12 bytes a voxel).
+  const std::string vectors_file = path + ".vectors.tmp";
+  struct RemoveOnExit {
+    std::string file;
+    ~RemoveOnExit() { std::remove(file.c_str()); }
+  } remove_vectors{vectors_file};
+  {
+    std::FILE* out = std::fopen(vectors_file.c_str(), "wb");
+    require(out != nullptr, "cannot create a temporary file", vectors_file, "check the folder and its permissions");
+    std::vector<Float32> block;
+    bool ok = true;
+    constexpr std::size_t kBlockFloats = std::size_t(1) << 18;
+    for (std::size_t first = 0; ok && first < displacement_lps_m.size(); first += kBlockFloats) {
+      const std::size_t count = std::min(kBlockFloats, displacement_lps_m.size() - first);
+      block.resize(count);
+      for (std::size_t n = 0; n < count; ++n) block[n] = Float32(1e3 * double(displacement_lps_m[first + n]));
+      static_assert(std::endian::native == std::endian::little, "the file is read as little-endian");
+      ok = std::fwrite(block.data(), sizeof(Float32), count, out) == count;
+    }
+    ok = std::fclose(out) == 0 && ok;
+    require(ok, "cannot write a temporary file", vectors_file, "check free disk space");
+  }
+  put_grid.floats_from_file(DCM_VectorGridData, vectors_file, sizeof(Float32) * displacement_lps_m.size());
   // Common Instance Reference: the source's series and the warped CT's.
   if (!source_instances.empty()) {
     DatasetWriter series(put.item(DCM_ReferencedSeriesSequence), path);
@@ -659,6 +676,24 @@ WrittenDicomSeries replace_dicom_series(const std::string& dir, const ImageVolum
   require(!ec, "the new series is in place, but the earlier one could not be removed: " + ec.message(),
           old_dir.string());
   return written;
+}
+
+/// A name-based (SHA-1, version 5) UUID of `name` as a DICOM UID under the 2.25 root
+/// (PS3.5 B.2): the same name always gives the same UID.
+std::string dicom::name_based_uid(const std::string& name) {
+  // RFC 4122 version 5 in VoxBreast's own namespace (a fixed random UUID).
+  static const unsigned char kNamespace[16] = {0x3c, 0x8e, 0x52, 0x0b, 0x9d, 0x41, 0x4f, 0x6a,
+                                               0xa7, 0x1e, 0x0c, 0x55, 0xd2, 0x93, 0x68, 0xf4};
+  Digest sha1(EVP_sha1());
+  sha1.add(kNamespace, sizeof kNamespace);
+  sha1.add(name.data(), name.size());
+  const std::string digest = sha1.finish();
+  OFUUID::BinaryRepresentation bytes;
+  std::copy(digest.begin(), digest.begin() + 16, bytes.value);
+  bytes.value[6] = Uint8((bytes.value[6] & 0x0f) | 0x50);  // version 5
+  bytes.value[8] = Uint8((bytes.value[8] & 0x3f) | 0x80);  // RFC 4122 variant
+  OFString text;
+  return OFUUID(bytes).toString(text, OFUUID::ER_RepresentationOID).c_str();
 }
 
 }  // namespace vb

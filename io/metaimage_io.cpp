@@ -3,12 +3,14 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 
 #include "engine/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/gzip_blocks.hpp"
 
 namespace vb {
 namespace {
@@ -34,7 +36,7 @@ std::string numbers_text(const double* values, int count) {
 
 /// MetaImage header for a 3-channel float image on `grid`'s voxels; ITK's order of keys, ending
 /// with ElementDataFile (the data follow it).
-std::string header(const ImageVolume& grid, std::size_t compressed_bytes, const std::string& path) {
+std::string header(const ImageVolume& grid, const std::string& compressed_bytes, const std::string& path) {
   const Eigen::Matrix3d axes_mm = grid.affine_lps_m.topLeftCorner<3, 3>() * 1e3;
   double spacing[3], origin[3], direction[9];
   for (int a = 0; a < 3; ++a) {
@@ -51,78 +53,65 @@ std::string header(const ImageVolume& grid, std::size_t compressed_bytes, const 
     for (int r = 0; r < 3; ++r) direction[3 * a + r] = unit(r, a);
   const double dims[3] = {double(grid.dims[0]), double(grid.dims[1]), double(grid.dims[2])};
   return "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n"
-         "CompressedData = True\nCompressedDataSize = " + std::to_string(compressed_bytes) +
+         "CompressedData = True\nCompressedDataSize = " + compressed_bytes +
          "\nTransformMatrix = " + numbers_text(direction, 9) + "\nOffset = " + numbers_text(origin, 3) +
          "\nCenterOfRotation = 0 0 0\nElementSpacing = " + numbers_text(spacing, 3) +
          "\nDimSize = " + numbers_text(dims, 3) +
          "\nElementNumberOfChannels = 3\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n";
 }
 
-/// The voxels as LPS mm float32 (little-endian), deflated (zlib stream) chunk by chunk.
-std::string compressed_mm(const ImageVolume& grid, const std::vector<float>& u_m, const std::string& path) {
-  z_stream z{};
-  require(deflateInit(&z, Z_BEST_SPEED) == Z_OK, "cannot start zlib compression", path);
-  std::string out;
-  std::vector<float> chunk;
-  std::vector<unsigned char> buffer(1 << 20);
-  const std::size_t n = grid.voxel_count(), per_chunk = 1 << 16;
-  const auto drain = [&](int flush) {
-    do {
-      z.next_out = buffer.data();
-      z.avail_out = unsigned(buffer.size());
-      const int status = deflate(&z, flush);
-      if (status == Z_STREAM_ERROR) {
-        deflateEnd(&z);
-        throw Error("zlib compression failed", path);
-      }
-      out.append(reinterpret_cast<const char*>(buffer.data()), buffer.size() - z.avail_out);
-    } while (z.avail_out == 0);
-  };
-  for (std::size_t first = 0; first < n; first += per_chunk) {
-    const std::size_t count = std::min(per_chunk, n - first);
-    chunk.resize(kComponents * count);
-    for (std::size_t v = 0; v < kComponents * count; ++v) {
-      const float u = u_m[kComponents * first + v];
-      if (!std::isfinite(u)) {
-        deflateEnd(&z);
-        const std::size_t voxel = first + v / kComponents, nx = std::size_t(grid.dims[0]), ny = std::size_t(grid.dims[1]);
-        throw Error("displacement is not finite at voxel (" + std::to_string(voxel % nx) + ", " +
-                        std::to_string(voxel / nx % ny) + ", " + std::to_string(voxel / (nx * ny)) + ")",
-                    path);
-      }
-      chunk[v] = float(double(u) * 1e3);
-    }
-    z.next_in = reinterpret_cast<unsigned char*>(chunk.data());
-    z.avail_in = unsigned(chunk.size() * sizeof(float));
-    drain(Z_NO_FLUSH);
-  }
-  z.next_in = nullptr;
-  z.avail_in = 0;
-  drain(Z_FINISH);
-  deflateEnd(&z);
-  return out;
+/// CompressedDataSize's text, padded with spaces to a fixed width so that the header can be
+/// written before the data and its size filled in after them.
+std::string size_field(std::size_t bytes) {
+  std::string text = std::to_string(bytes);
+  text.resize(20, ' ');
+  return text;
 }
 
 }  // namespace
 
 void write_metaimage_displacement(const std::string& path, const ImageVolume& grid,
-                                  const std::vector<float>& displacement_lps_m) {
+                                  const std::vector<float>& displacement_lps_m,
+                                  const std::function<void(double)>& progress) {
   require(path.size() > 4 && path.compare(path.size() - 4, 4, ".mha") == 0,
           "a MetaImage displacement field is written as one '.mha' file", path);
   require(displacement_lps_m.size() == kComponents * grid.voxel_count(),
           "displacement has " + std::to_string(displacement_lps_m.size()) + " floats for " +
               std::to_string(grid.voxel_count()) + " voxels (3 per voxel expected)",
           path);
-  const std::string data = compressed_mm(grid, displacement_lps_m, path);
-  const std::string text = header(grid, data.size(), path);
+  // The voxels as LPS mm float32 (little-endian), one zlib stream deflated in blocks on all cores.
+  const std::string placeholder = header(grid, size_field(0), path);
   AtomicOutput output(path);
-  {
-    std::ofstream file(output.temp_path(), std::ios::binary);
-    file.write(text.data(), std::streamsize(text.size()));
-    file.write(data.data(), std::streamsize(data.size()));
-    file.close();
-    require(bool(file), "cannot write the file", path);
+  std::FILE* file = std::fopen(output.temp_path().c_str(), "wb");
+  require(file != nullptr, "cannot create file", path, "check the folder and its permissions");
+  const std::size_t n = grid.voxel_count(), nx = std::size_t(grid.dims[0]), ny = std::size_t(grid.dims[1]);
+  bool ok = false;
+  try {
+    ok = std::fwrite(placeholder.data(), 1, placeholder.size(), file) == placeholder.size() &&
+         write_blocks(file, "", sizeof(float) * kComponents * n, [&](std::size_t offset, unsigned char* bytes, std::size_t size) {
+           static_assert(std::endian::native == std::endian::little, "MetaImage data are written little-endian");
+           float* out = reinterpret_cast<float*>(bytes);  // blocks split between floats (sizes are multiples of 4)
+           for (std::size_t f = offset / sizeof(float), end = f + size / sizeof(float); f < end; ++f) {
+             const float u = displacement_lps_m[f];
+             if (!std::isfinite(u)) {
+               const std::size_t voxel = f / kComponents;
+               throw Error("displacement is not finite at voxel (" + std::to_string(voxel % nx) + ", " +
+                               std::to_string(voxel / nx % ny) + ", " + std::to_string(voxel / (nx * ny)) + ")",
+                           path);
+             }
+             *out++ = float(double(u) * 1e3);
+           }
+         }, BlockCompression::Zlib, Z_BEST_SPEED, progress);
+    const long end = std::ftell(file);
+    const std::string text = header(grid, size_field(std::size_t(end) - placeholder.size()), path);
+    ok = ok && end > 0 && text.size() == placeholder.size() && std::fseek(file, 0, SEEK_SET) == 0 &&
+         std::fwrite(text.data(), 1, text.size(), file) == text.size();
+  } catch (...) {
+    std::fclose(file);
+    throw;
   }
+  ok = std::fclose(file) == 0 && ok;
+  require(ok, "cannot write the file", path, "check free disk space");
   output.commit();
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 /// NIfTI reading and writing (nifti_clib), converting between the file's RAS world in millimetres
 /// and VoxBreast's DICOM LPS world in metres. The rules are in docs/FORMATS.md, section "NIfTI".
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -30,7 +31,9 @@ enum class NiftiType { Int16, UInt8, Float32 };
 /// do) prefer the sform. xyzt_units = mm. Integer types round to nearest; a value outside the
 /// type's range or not finite throws vb::Error rather than saturating. A "LABEL" modality is
 /// written with intent NIFTI_INTENT_LABEL. The file appears atomically (AtomicOutput).
-void write_nifti(const std::string& path, const ImageVolume& image, NiftiType type);
+/// `progress` is told the fraction written, from the calling thread.
+void write_nifti(const std::string& path, const ImageVolume& image, NiftiType type,
+                 const std::function<void(double)>& progress = {});
 
 /// How a displacement field's vectors are stored in a NIfTI file.
 enum class NiftiDisplacementLayout {
@@ -48,7 +51,8 @@ enum class NiftiDisplacementLayout {
 /// sform/qform as write_nifti. u maps a point x of the grid to x + u(x). Atomic like write_nifti.
 void write_nifti_displacement(const std::string& path, const ImageVolume& grid,
                               const std::vector<float>& displacement_lps_m,
-                              NiftiDisplacementLayout layout = NiftiDisplacementLayout::DispVectRas);
+                              NiftiDisplacementLayout layout = NiftiDisplacementLayout::DispVectRas,
+                              const std::function<void(double)>& progress = {});
 
 /// The inverse of write_nifti_displacement: returns the grid (values empty, affine as
 /// read_nifti) and fills `displacement_lps_m` (3 per voxel, LPS metres). Accepts dims

@@ -1,4 +1,5 @@
 #include "io/scene_file.hpp"
+#include "io/scene_structures.hpp"
 #include "io/toml_text.hpp"
 
 #include <toml++/toml.h>
@@ -75,6 +76,23 @@ std::map<int, std::string> read_label_table(const Section& s) {
   return table;
 }
 
+/// `[model.structure_table]`: ROI name → tissue name.
+std::map<std::string, std::string> read_structure_table(const Section& s) {
+  std::map<std::string, std::string> table;
+  for (const std::string& key : s.keys()) table[key] = s.required(key, s.text(key));
+  if (table.empty()) s.fail("", "the structure table is empty", "map ROI names to tissue names");
+  return table;
+}
+
+/// `model.structures`, `[model.structure_table]` and `model.structure_priority` (path as written).
+StructureSpec read_structure_spec(const Section& s) {
+  StructureSpec spec;
+  spec.path = s.text("structures").value_or("");
+  if (const auto table = s.table("structure_table")) spec.table = read_structure_table(*table);
+  spec.priority = s.strings("structure_priority").value_or(std::vector<std::string>{});
+  return spec;
+}
+
 HuClass read_hu_class(const Section& s) {
   s.check_keys({"tissue", "min", "max"});
   HuClass c;
@@ -104,10 +122,16 @@ void read_image_model(const Section& s, ModelSpec& model) {
   model.labels_path = s.text("labels").value_or("");
   if (const auto table = s.table("label_table")) model.label_table = read_label_table(*table);
   for (const Section& c : s.tables("hu_class")) model.hu_classes.push_back(read_hu_class(c));
-  const bool by_labels = !model.labels_path.empty();
-  if (by_labels == !model.hu_classes.empty()) {
-    s.fail("image", "an image model needs exactly one of 'labels' (with [model.label_table]) or [[model.hu_class]]");
+  const StructureSpec structures = read_structure_spec(s);
+  const bool by_labels = !model.labels_path.empty(), by_structures = !structures.path.empty();
+  if (int(by_labels) + int(by_structures) + int(!model.hu_classes.empty()) != 1) {
+    s.fail("image", "an image model needs exactly one of 'labels' (with [model.label_table]), 'structures' (with "
+                    "[model.structure_table]) or [[model.hu_class]]");
   }
+  if (by_structures && structures.table.empty())
+    s.fail("structures", "'structures' needs a [model.structure_table]");
+  if (!by_structures && (!structures.table.empty() || !structures.priority.empty()))
+    s.fail(structures.table.empty() ? "structure_priority" : "structure_table", "needs 'structures'");
   if (by_labels && model.label_table.empty()) s.fail("labels", "'labels' needs a [model.label_table]");
   if (!by_labels && !model.label_table.empty()) s.fail("label_table", "[model.label_table] needs 'labels'");
   model.keep = s.strings("keep").value_or(std::vector<std::string>{});
@@ -122,7 +146,7 @@ void read_image_model(const Section& s, ModelSpec& model) {
 
 ModelSpec read_model(const Section& s) {
   s.check_keys({"spacing", "downsample", "shape", "image", "series", "allow_gaps", "labels", "label_table",
-                "hu_class", "keep", "roi_min", "roi_max"});
+                "hu_class", "keep", "roi_min", "roi_max", "structures", "structure_table", "structure_priority"});
   ModelSpec model;
   model.line = s.line();
   model.downsample = s.integer<int>("downsample", 1).value_or(model.downsample);
@@ -132,7 +156,8 @@ ModelSpec read_model(const Section& s) {
     read_image_model(s, model);
     return model;
   }
-  for (const char* key : {"series", "allow_gaps", "labels", "label_table", "hu_class", "keep", "roi_min", "roi_max"}) {
+  for (const char* key : {"series", "allow_gaps", "labels", "label_table", "hu_class", "keep", "roi_min", "roi_max",
+                          "structures", "structure_table", "structure_priority"}) {
     if (s.find(key)) s.fail(key, "applies to image models only", "add model.image or remove it");
   }
   if (model.shapes.empty()) {
@@ -654,7 +679,7 @@ OutputSpec read_output(const Section& s, const ModelSpec& model) {
 
 /// Runs after everything is read: shapes may come before the materials they name. A tissue
 /// needs a [materials.X] table unless it has a default material.
-void check_labels(Scene& scene, const std::string& source) {
+void check_labels(Scene& scene, const std::string& source, const StructureSpec& structures) {
   const std::vector<std::string> defaults = default_material_names();  // outlives the views in `names`
   Keys names;
   for (const auto& entry : scene.materials) names.push_back(entry.first);
@@ -673,6 +698,8 @@ void check_labels(Scene& scene, const std::string& source) {
     resolve(scene.model.shapes[i].label, scene.model.shapes[i].line, "model.shape[" + std::to_string(i) + "].label");
   for (const auto& [value, tissue] : scene.model.label_table)
     resolve(tissue, scene.model.line, "model.label_table." + std::to_string(value));
+  for (const auto& [roi, tissue] : structures.table)
+    if (tissue != "ignore") resolve(tissue, scene.model.line, "model.structure_table." + roi);
   for (std::size_t i = 0; i < scene.model.hu_classes.size(); ++i)
     resolve(scene.model.hu_classes[i].tissue, scene.model.hu_classes[i].line, "model.hu_class[" + std::to_string(i) + "].tissue");
 }
@@ -730,14 +757,23 @@ Scene parse_scene_text(const std::string& text, const std::string& source_name) 
     if (!scene.indenters[i].has_start && scene.indenters[i].path.empty() && !(scene.probe.active && scene.probe.indenter == i))
       throw Error("missing required key", where_string(source_name, scene.indenters[i].line, "indenter[" + std::to_string(i) + "].start"),
                   "only the [probe] indenter may leave out 'start'");
-  check_labels(scene, source_name);
+  check_labels(scene, source_name, read_structure_spec(top.table_or_empty("model")));
   scene.source_text = text;
   return scene;
 }
 
 const std::vector<std::string>& scene_path_keys() {
-  static const std::vector<std::string> keys = {"model.image", "model.labels"};  // as resolve_paths
+  // model.image and model.labels as resolve_paths; model.structures as scene_structures
+  static const std::vector<std::string> keys = {"model.image", "model.labels", "model.structures"};
   return keys;
+}
+
+StructureSpec scene_structures(const Scene& scene) {
+  const toml::table root = parse_toml_text(scene.source_text, scene.source_path);
+  StructureSpec spec = read_structure_spec(Section(root, "", scene.source_path).table_or_empty("model"));
+  if (!spec.path.empty() && std::filesystem::path(spec.path).is_relative())
+    spec.path = (std::filesystem::path(scene.source_path).parent_path() / spec.path).lexically_normal().string();
+  return spec;
 }
 
 DvfFileOptions dvf_file_options(const Scene& scene) {

@@ -43,7 +43,7 @@ constexpr double kGlandCentreDepthFraction = 0.45;  // of the breast depth: behi
 constexpr double kGlandExtentFraction = 0.57;       // of each breast radius
 
 // Keeps a phantom request from exhausting memory (two float volumes plus a copy).
-constexpr double kMaxVoxels = 5.0e7;
+constexpr double kMaxVoxels = 1.2e8;
 
 // ---------------------------------------------------------------- formatting and validation
 
@@ -172,9 +172,15 @@ const PhantomTumour* tumour_at(const Eigen::Vector3d& p, const std::vector<Phant
 
 // ---------------------------------------------------------------- validation
 
+/// Voxel edges along x, y, z (m): spacing_xyz_m when set, else spacing_m on every axis.
+Eigen::Vector3d voxel_edges_m(const PhantomSpec& spec) {
+  return (spec.spacing_xyz_m.array() > 0).all() ? spec.spacing_xyz_m : Eigen::Vector3d::Constant(spec.spacing_m);
+}
+
 void validate_spacing(const PhantomSpec& spec) {
-  require(positive(spec.spacing_m) && spec.spacing_m <= 0.01,
-          "spacing must be in (0, 10] mm, got " + mm_text(spec.spacing_m), "phantom.spacing_m");
+  const Eigen::Vector3d h_m = voxel_edges_m(spec);
+  require(h_m.allFinite() && (h_m.array() > 0).all() && h_m.maxCoeff() <= 0.01,
+          "spacing must be in (0, 10] mm, got " + mm_text(h_m), "phantom.spacing_m");
 }
 
 void validate_geometry(const PhantomSpec& spec) {
@@ -196,7 +202,7 @@ void validate_geometry(const PhantomSpec& spec) {
           "phantom.chest_wall_depth_m", "pectoral_thickness_m + 2·rib_half_thickness_m ≤ chest_wall_depth_m");
   require(positive(spec.rib_pitch_m) && spec.rib_pitch_m > 2.0 * spec.rib_half_height_m,
           "rib pitch must exceed the rib height so ribs stay apart", "phantom.rib_pitch_m");
-  require(std::isfinite(spec.fov_margin_m) && spec.fov_margin_m >= spec.spacing_m,
+  require(std::isfinite(spec.fov_margin_m) && spec.fov_margin_m >= voxel_edges_m(spec).maxCoeff(),
           "field-of-view margin must be at least one voxel (air must surround the breast)",
           "phantom.fov_margin_m");
   require(std::isfinite(spec.noise_sigma_hu) && spec.noise_sigma_hu >= 0.0,
@@ -227,18 +233,32 @@ int voxels_covering(double length_m, double spacing_m) {
 
 /// Axis-aligned grid: breast centre on a voxel centre at x = z = 0, a voxel plane at y = 0.
 ImageVolume make_grid(const PhantomSpec& spec, std::string modality) {
-  const double h_m = spec.spacing_m;
-  const int half_x = voxels_covering(spec.breast_radii_m.x() + spec.fov_margin_m, h_m);
-  const int half_z = voxels_covering(spec.breast_radii_m.z() + spec.fov_margin_m, h_m);
-  const int anterior = voxels_covering(spec.breast_radii_m.y() + spec.fov_margin_m, h_m);
-  const int posterior = voxels_covering(spec.chest_wall_depth_m, h_m);
+  const Eigen::Vector3d h_m = voxel_edges_m(spec);
+  // Voxels from the breast centre to the field's edges: −x, +x, anterior (−y), posterior, −z, +z.
+  int half_x = voxels_covering(spec.breast_radii_m.x() + spec.fov_margin_m, h_m.x());
+  int half_z = voxels_covering(spec.breast_radii_m.z() + spec.fov_margin_m, h_m.z());
+  int anterior = voxels_covering(spec.breast_radii_m.y() + spec.fov_margin_m, h_m.y());
+  int posterior = voxels_covering(spec.chest_wall_depth_m, h_m.y());
   ImageVolume vol;
   vol.dims = {2 * half_x + 1, anterior + posterior + 1, 2 * half_z + 1};
+  std::array<int, 3> low = {half_x, anterior, half_z};  // the index of the breast centre
+  if (std::all_of(spec.dims.begin(), spec.dims.end(), [](int n) { return n > 0; })) {
+    for (int a = 0; a < 3; ++a)
+      require(spec.dims[a] >= vol.dims[a],
+              "dims " + std::to_string(spec.dims[0]) + " × " + std::to_string(spec.dims[1]) + " × " +
+                  std::to_string(spec.dims[2]) + " do not cover the phantom: it needs at least " +
+                  std::to_string(vol.dims[0]) + " × " + std::to_string(vol.dims[1]) + " × " +
+                  std::to_string(vol.dims[2]) + " voxels at this spacing",
+              "phantom.dims", "give more voxels or a larger spacing");
+    // The extra voxels split evenly on both sides of what the phantom needs.
+    for (int a = 0; a < 3; ++a) low[a] += (spec.dims[a] - vol.dims[a]) / 2;
+    vol.dims = spec.dims;
+  }
   const double voxels = double(vol.dims[0]) * vol.dims[1] * vol.dims[2];
   require(voxels <= kMaxVoxels, "the phantom would have " + std::to_string(long(voxels)) + " voxels",
           "phantom.spacing_m", "increase the spacing or shrink the field of view");
-  vol.affine_lps_m.topLeftCorner<3, 3>() = h_m * Eigen::Matrix3d::Identity();
-  vol.affine_lps_m.topRightCorner<3, 1>() = -h_m * Eigen::Vector3d(half_x, anterior, half_z);
+  vol.affine_lps_m.topLeftCorner<3, 3>() = Eigen::Matrix3d(h_m.asDiagonal());
+  vol.affine_lps_m.topRightCorner<3, 1>() = -h_m.cwiseProduct(Eigen::Vector3d(low[0], low[1], low[2]));
   vol.values.assign(vol.voxel_count(), 0.0f);
   vol.modality = std::move(modality);
   return vol;
@@ -271,14 +291,15 @@ bool is_soft_tissue(float label) {
   return label == float(lbl::adipose) || label == float(lbl::fibroglandular) || label == float(lbl::muscle);
 }
 
-/// Integer offsets within radius_vox of the origin (the origin included).
-std::vector<Eigen::Vector3i> ball_offsets(double radius_vox) {
-  const int reach = int(std::floor(radius_vox + 1e-9));
+/// Integer offsets within the ellipsoid of semi-axes radius_vox (in voxels along i, j, k) of the
+/// origin (the origin included).
+std::vector<Eigen::Vector3i> ball_offsets(const Eigen::Vector3d& radius_vox) {
+  const Eigen::Vector3i reach = (radius_vox.array() + 1e-9).floor().cast<int>().matrix();
   std::vector<Eigen::Vector3i> offsets;
-  for (int c = -reach; c <= reach; ++c)
-    for (int b = -reach; b <= reach; ++b)
-      for (int a = -reach; a <= reach; ++a)
-        if (a * a + b * b + c * c <= radius_vox * radius_vox + 1e-9) offsets.emplace_back(a, b, c);
+  for (int c = -reach.z(); c <= reach.z(); ++c)
+    for (int b = -reach.y(); b <= reach.y(); ++b)
+      for (int a = -reach.x(); a <= reach.x(); ++a)
+        if (Eigen::Vector3d(a, b, c).cwiseQuotient(radius_vox).squaredNorm() <= 1 + 1e-9) offsets.emplace_back(a, b, c);
   return offsets;
 }
 
@@ -299,12 +320,13 @@ void paint_anatomy(ImageVolume& labels, const PhantomSpec& spec, const std::vect
   });
 }
 
-/// Every body voxel within the skin thickness (and at least one voxel) of air becomes skin, so
-/// the skin closes over the breast and the chest-wall front at any spacing. Only air voxels on
-/// the body's edge are visited: the nearest air voxel to any body voxel is one of them.
+/// Every body voxel within the skin thickness (and at least one voxel along each axis) of air
+/// becomes skin, so the skin closes over the breast and the chest-wall front at any spacing. Only
+/// air voxels on the body's edge are visited: the nearest air voxel to any body voxel is one of them.
 void paint_skin(ImageVolume& labels, double skin_thickness_m) {
-  const double h_m = labels.spacing_m().x();
-  const std::vector<Eigen::Vector3i> ball = ball_offsets(std::max(skin_thickness_m, h_m) / h_m);
+  const Eigen::Vector3d h_m = labels.spacing_m();
+  const std::vector<Eigen::Vector3i> ball =
+      ball_offsets(h_m.cwiseMax(Eigen::Vector3d::Constant(skin_thickness_m)).cwiseQuotient(h_m));
   const ImageVolume anatomy = labels;  // body membership before skin is painted
   for_each_voxel(anatomy, [&](const Eigen::Vector3i& ijk, std::size_t n) {
     if (!is_air(anatomy.values[n]) || !touches_body(anatomy, ijk)) return;

@@ -4,6 +4,7 @@
 /// mound protrudes anteriorly (−y) from the chest wall, whose front is the plane y = 0; the
 /// breast is centred at x = z = 0.
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -32,6 +33,13 @@ struct PhantomTumour {
 struct PhantomSpec {
   std::uint64_t seed = 1;               ///< fixes the glandular texture and the image noise
   double spacing_m = 0.002;             ///< isotropic voxel edge, (0, 0.01] m
+  /// Voxel edges along x, y, z (m, each in (0, 0.01]) when set (all three > 0); else spacing_m
+  /// on every axis. E.g. a planning CT's 0.98 × 0.98 × 2.5 mm.
+  Eigen::Vector3d spacing_xyz_m = Eigen::Vector3d::Zero();
+  /// Voxels along x, y, z when set (all three > 0): a field of view of that size, centred on
+  /// the breast in x and z and on the mound and chest-wall slab in y, which it must cover;
+  /// else the smallest grid covering them with fov_margin_m of air.
+  std::array<int, 3> dims{0, 0, 0};
   std::vector<PhantomTumour> tumours;   ///< spheres painted over soft tissue, later ones on top
 
   /// Breast mound semi-axes (m): x half-width, y anterior depth (flattened by gravity when

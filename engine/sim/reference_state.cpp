@@ -50,22 +50,25 @@ Scene reference_state_scene(const Scene& scene) {
 }
 
 ReferenceState estimate_reference_state(const Scene& scene, const Lattice& lattice, const ClContext& cl,
-                                        const std::function<void(const ReferenceIteration&)>& on_iteration) {
+                                        const std::function<void(const ReferenceIteration&)>& on_iteration,
+                                        const std::function<void(const RunProgress&)>& on_step) {
   return estimate_reference_state(scene, lattice, make_element_arrays(reference_state_scene(scene), lattice), cl, {},
-                                  on_iteration);
+                                  on_iteration, on_step);
 }
 
 ReferenceState estimate_reference_state(const Scene& scene, const Lattice& lattice, const ElementArrays& el,
                                         const ClContext& cl, const std::vector<double>& first_offset_m,
-                                        const std::function<void(const ReferenceIteration&)>& on_iteration) {
+                                        const std::function<void(const ReferenceIteration&)>& on_iteration,
+                                        const std::function<void(const RunProgress&)>& on_step) {
   const Scene ct = reference_state_scene(scene);  // the simulator keeps a reference: it lives as long as sim
   Simulator sim(ct, lattice, el, cl);
-  return estimate_reference_state(sim, scene, lattice, el, first_offset_m, on_iteration);
+  return estimate_reference_state(sim, scene, lattice, el, first_offset_m, on_iteration, on_step);
 }
 
 ReferenceState estimate_reference_state(Simulator& sim, const Scene& scene, const Lattice& lattice,
                                         const ElementArrays& el, const std::vector<double>& first_offset_m,
-                                        const std::function<void(const ReferenceIteration&)>& on_iteration) {
+                                        const std::function<void(const ReferenceIteration&)>& on_iteration,
+                                        const std::function<void(const RunProgress&)>& on_step) {
   ReferenceState out;
   const auto start = std::chrono::steady_clock::now();
   const Scene ct = reference_state_scene(scene);
@@ -96,7 +99,7 @@ ReferenceState estimate_reference_state(Simulator& sim, const Scene& scene, cons
     sim.restart_clock();
     RunOutput run;
     try {
-      run = run_simulation(ct, lattice, el, sim);
+      run = run_simulation(ct, lattice, el, sim, on_step);
     } catch (const Error&) {
       if (it == 1) throw;  // unstable from the CT itself: the scene's problem, reported as such
       return std::nullopt;

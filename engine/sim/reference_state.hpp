@@ -8,6 +8,7 @@
 #include <functional>
 #include <vector>
 
+#include "engine/sim/run.hpp"
 #include "engine/sim/simulator.hpp"
 
 namespace vb {
@@ -44,10 +45,11 @@ Scene reference_state_scene(const Scene& scene);
 /// [reference_state] max_iterations forward solves are done (then `converged` is false). A step
 /// that lands farther from the CT (or goes unstable) is retried shorter: history lists every
 /// solve, and the result keeps the best rest offsets. `on_iteration` is
-/// called after each forward solve. Throws vb::Error when a forward solve does not reach
+/// called after each forward solve, `on_step` at each equilibrium check of a solve. Throws vb::Error when a forward solve does not reach
 /// equilibrium or goes unstable.
 ReferenceState estimate_reference_state(const Scene& scene, const Lattice& lattice, const ClContext& cl,
-                                        const std::function<void(const ReferenceIteration&)>& on_iteration = {});
+                                        const std::function<void(const ReferenceIteration&)>& on_iteration = {},
+                                        const std::function<void(const RunProgress&)>& on_step = {});
 
 /// The same with the caller's element arrays (e.g. a fit's trial moduli; built for this scene and
 /// lattice) and a first estimate of the rest offsets (n×3; empty: zero, the CT as rest shape). A
@@ -55,13 +57,15 @@ ReferenceState estimate_reference_state(const Scene& scene, const Lattice& latti
 /// forward solves.
 ReferenceState estimate_reference_state(const Scene& scene, const Lattice& lattice, const ElementArrays& elements,
                                         const ClContext& cl, const std::vector<double>& first_offset_m,
-                                        const std::function<void(const ReferenceIteration&)>& on_iteration = {});
+                                        const std::function<void(const ReferenceIteration&)>& on_iteration = {},
+                                        const std::function<void(const RunProgress&)>& on_step = {});
 
 /// The same on the caller's simulator of reference_state_scene(scene) with these element arrays
 /// (built with them, or given them by Simulator::set_materials): a fit keeps one across its
 /// solves (engine/fit/reference_forward.hpp). Its rest offsets and state are the iteration's.
 ReferenceState estimate_reference_state(Simulator& sim, const Scene& scene, const Lattice& lattice,
                                         const ElementArrays& elements, const std::vector<double>& first_offset_m,
-                                        const std::function<void(const ReferenceIteration&)>& on_iteration = {});
+                                        const std::function<void(const ReferenceIteration&)>& on_iteration = {},
+                                        const std::function<void(const RunProgress&)>& on_step = {});
 
 }  // namespace vb

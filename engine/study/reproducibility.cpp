@@ -52,7 +52,8 @@ std::optional<std::string> unsettled_runs_warning(const ReproducibilityResult& r
 
 ReproducibilityResult run_reproducibility(const Scene& scene, const Lattice& lattice, const ClContext& cl,
                                           const std::vector<double>* rest_offsets_m,
-                                          const std::function<void(const PerturbedRun&)>& on_run) {
+                                          const std::function<void(const PerturbedRun&)>& on_run,
+                                          const std::function<void(const RunProgress&)>& on_step) {
   const std::string where = "reproducibility (line " + std::to_string(scene.reproducibility.line) + ")";
   const AnchorSpec* wall = chest_wall_anchor(scene);
   require(wall && wall->kind == AnchorSpec::Kind::Sphere, "the chest wall to perturb is not a sphere anchor", where,
@@ -80,7 +81,7 @@ ReproducibilityResult run_reproducibility(const Scene& scene, const Lattice& lat
       sim.restart_clock();
       // The patient turns under the fixed device, so the rings may start in the skin: the first
       // steps push it out, which is the device holding the breast.
-      const RunOutput run = run_simulation(posed, lattice, el, sim, {}, /*refuse_penetrating_start=*/false);
+      const RunOutput run = run_simulation(posed, lattice, el, sim, on_step, /*refuse_penetrating_start=*/false);
       const PositioningMetrics m = compute_positioning_metrics(posed, lattice, el, run.summary, run.state);
       require(m.tumour.has_value(), "the scene has no tumour tissue to follow", where,
               "set [positioning] tumour_tissue to the tissue to follow");

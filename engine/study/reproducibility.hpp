@@ -12,6 +12,7 @@
 #include "engine/sim/opencl_runtime.hpp"
 #include "engine/lattice/lattice.hpp"
 #include "engine/scene/scene.hpp"
+#include "engine/sim/run.hpp"
 
 namespace vb {
 
@@ -53,9 +54,11 @@ std::optional<std::string> unsettled_runs_warning(const ReproducibilityResult& r
 /// Runs the perturbations on `cl`: each is the scene's run from the CT (same integrator, stop
 /// rule and, when given, the same unloaded rest offsets) with the chest-wall anchor turned.
 /// Throws vb::Error when the scene has no tumour tissue or no sphere chest-wall anchor, or a run
-/// goes unstable; a run that stops without equilibrium is kept and marked.
+/// goes unstable; a run that stops without equilibrium is kept and marked. `on_run` is called
+/// after each run, `on_step` at each equilibrium check of a run.
 ReproducibilityResult run_reproducibility(const Scene& scene, const Lattice& lattice, const ClContext& cl,
                                           const std::vector<double>* rest_offsets_m,
-                                          const std::function<void(const PerturbedRun&)>& on_run = {});
+                                          const std::function<void(const PerturbedRun&)>& on_run = {},
+                                          const std::function<void(const RunProgress&)>& on_step = {});
 
 }  // namespace vb

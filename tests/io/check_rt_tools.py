@@ -11,9 +11,16 @@ prone; relaxation, 8 mm lattice, for speed) with the legacy NIfTI DVF layout, th
 - the same field in the standard layout (intent 1006, RAS) is not read as a displacement by
   either tool (docs/FORMATS.md's table says so: checked here, not assumed);
 - plastimatch stats on dvf.mha and dvf_inverse.mha equal summary.json's dvf_stats_mm;
-- dciodvfy finds 0 errors in every warped CT slice, in dvf_inverse.dcm and in the bundled
-  phantom series; pydicom reads dvf_inverse.dcm's grid back equal to dvf_inverse.mha and the
-  warped CT's SourceImageSequence names slices of the input series.
+- dciodvfy finds 0 errors in every warped CT slice, in dvf_inverse.dcm, in warped_structures.dcm,
+  in the bundled phantom series and in a fresh `voxbreast phantom`'s series and rtstruct.dcm;
+  pydicom reads dvf_inverse.dcm's grid back equal to dvf_inverse.mha and the warped CT's
+  SourceImageSequence names slices of the input series;
+- RTSTRUCT: pydicom finds that warped_structures.dcm (and the phantom's rtstruct.dcm) references
+  its CT series, every slice of it, and its frame of reference; `plastimatch convert` rasterises
+  each ROI of both onto the referenced series, and its mask equals ours (warped_labels.nii.gz,
+  labels.nii.gz) voxel for voxel: the measure is the count of voxels where the two masks differ,
+  with the Dice coefficient printed, and the bound is 0 (our contours run along voxel edges, so
+  no voxel centre lies on a contour and every rasteriser that tests voxel centres agrees).
 Exit 0 when all checks pass, 1 on a failure, 77 (ctest SKIP_RETURN_CODE) when a tool is missing.
 """
 import glob
@@ -36,6 +43,7 @@ except ImportError as error:
     sys.exit(77)
 
 TOOLS = ("plastimatch", "transformix", "dciodvfy")
+LABEL_NAMES = {1: "skin", 2: "adipose", 3: "fibroglandular", 4: "muscle", 5: "bone", 6: "tumour"}
 failures = []
 
 
@@ -146,6 +154,44 @@ def dciodvfy_errors(path):
     return [line for line in (result.stdout + result.stderr).splitlines() if line.startswith("Error")]
 
 
+def check_rtstruct(out, name, rtstruct, ct_dir, labels_path):
+    """pydicom's view of `rtstruct`'s references; plastimatch's masks of it against our label map."""
+    errors = dciodvfy_errors(rtstruct)
+    check(not errors, f"dciodvfy: {len(errors)} errors in {name}" + (f" (first: {errors[0]})" if errors else ""))
+    rs = pydicom.dcmread(rtstruct)
+    ct = [pydicom.dcmread(f, stop_before_pixels=True) for f in sorted(glob.glob(f"{ct_dir}/*.dcm"))]
+    frame = rs.ReferencedFrameOfReferenceSequence[0]
+    series = frame.RTReferencedStudySequence[0].RTReferencedSeriesSequence[0]
+    check(rs.Modality == "RTSTRUCT" and rs.StudyInstanceUID == ct[0].StudyInstanceUID
+          and frame.FrameOfReferenceUID == ct[0].FrameOfReferenceUID
+          and series.SeriesInstanceUID == ct[0].SeriesInstanceUID
+          and {i.ReferencedSOPInstanceUID for i in series.ContourImageSequence} == {c.SOPInstanceUID for c in ct},
+          f"pydicom: {name} references its CT series ({len(ct)} slices), study and frame of reference")
+    masks = f"{out}/masks_{name.replace('.', '_')}"
+    result = run(["plastimatch", "convert", "--input", rtstruct, "--referenced-ct", ct_dir, "--xor-contours",
+                  "--output-prefix", masks, "--prefix-format", "nii.gz"])
+    check(result.returncode == 0, f"plastimatch convert --input {name} exits 0")
+    if result.returncode != 0:
+        return
+    labels = nib.load(labels_path)
+    ours = np.asarray(labels.dataobj)
+    names = {r.ROINumber: r.ROIName for r in rs.StructureSetROISequence}
+    for number, roi in names.items():
+        expected = ours == int(number)
+        path = f"{masks}/{roi}.nii.gz"
+        if not os.path.exists(path):
+            check(False, f"plastimatch wrote no mask for {name} ROI '{roi}'")
+            continue
+        mask = nib.load(path)
+        theirs = np.asarray(mask.dataobj) > 0
+        same_grid = theirs.shape == expected.shape and np.allclose(mask.affine, labels.affine, atol=1e-3)
+        differ = int((theirs != expected).sum()) if same_grid else -1
+        dice = 2 * int((theirs & expected).sum()) / max(1, int(theirs.sum() + expected.sum())) if same_grid else 0
+        check(same_grid and differ == 0 and expected.any(),
+              f"plastimatch's mask of {name} ROI '{roi}': {differ} of {int(expected.sum())} voxels differ "
+              f"from ours (Dice {dice:.4f})")
+
+
 def main():
     if len(sys.argv) != 3:
         print(__doc__)
@@ -209,6 +255,17 @@ def main():
             errors = [e for f in files for e in dciodvfy_errors(f)]
             check(files and not errors, f"dciodvfy: {len(errors)} errors in {len(files)} {name}" +
                   (f" (first: {errors[0]})" if errors else ""))
+
+        check_rtstruct(out, "warped_structures.dcm", f"{out}/run/warped_structures.dcm", f"{out}/run/warped_ct_dicom",
+                       f"{out}/run/warped_labels.nii.gz")
+        fresh = run([binary, "phantom", "--out", f"{out}/phantom", "--spacing", "4", "--tumour", "idc,15,-20,10,8"])
+        check(fresh.returncode == 0, "voxbreast phantom")
+        if fresh.returncode == 0:
+            slices = sorted(glob.glob(f"{out}/phantom/dicom/*.dcm"))
+            errors = [e for f in slices for e in dciodvfy_errors(f)]
+            check(slices and not errors, f"dciodvfy: {len(errors)} errors in {len(slices)} fresh phantom slices")
+            check_rtstruct(out, "rtstruct.dcm", f"{out}/phantom/rtstruct.dcm", f"{out}/phantom/dicom",
+                           f"{out}/phantom/labels.nii.gz")
 
         source_uids = {pydicom.dcmread(f, stop_before_pixels=True).SOPInstanceUID for f in bundled}
         first = pydicom.dcmread(written[0], stop_before_pixels=True)

@@ -114,6 +114,26 @@ TEST_F(MetaImage, HeaderGivesItkTheGridAndDataAreLpsMillimetres) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);  // atomic: nothing else
 }
 
+/// A field of many compressed blocks (deflated on all cores, written in order): still one zlib
+/// stream whose Adler-32 holds, and CompressedDataSize (filled in after the data) its exact size;
+/// progress reaches 1.
+TEST_F(MetaImage, LargeFieldIsOneZlibStreamOfTheStatedSize) {
+  ImageVolume grid;
+  grid.dims = {90, 80, 70};  // 6 MB of floats: six blocks
+  grid.affine_lps_m.topLeftCorner<3, 3>() = 1e-3 * Eigen::Matrix3d::Identity();
+  std::vector<float> u(3 * grid.voxel_count());
+  for (std::size_t n = 0; n < u.size(); ++n) u[n] = n % 5 == 0 ? 0.f : float(1e-5 * double(n % 1013) - 0.004);
+  double last = -1;
+  write_metaimage_displacement(path("large.mha"), grid, u, [&](double f) {
+    EXPECT_GE(f, last);
+    last = f;
+  });
+  EXPECT_DOUBLE_EQ(last, 1.0);
+  const MetaFile file = read_meta(path("large.mha"));  // checks the size and that zlib inflates it whole
+  ASSERT_EQ(file.data.size(), u.size());
+  for (std::size_t n = 0; n < u.size(); ++n) ASSERT_FLOAT_EQ(file.data[n], float(double(u[n]) * 1e3)) << n;
+}
+
 TEST_F(MetaImage, RefusesShearNonFiniteValuesWrongSizesAndOtherNames) {
   ImageVolume grid = oblique_grid();
   std::vector<float> u = sample_field(grid);

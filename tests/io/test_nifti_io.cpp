@@ -379,6 +379,30 @@ TEST_F(NiftiIo, LegacyDisplacementLayoutIsIntent1007WithLpsComponents) {
   for (std::size_t f = 0; f < u.size(); ++f) ASSERT_NEAR(back[f], u[f], 1e-6 * std::abs(u[f]) + 1e-12);
 }
 
+/// Fields of several compressed blocks (written on all cores, each block deflated on its own):
+/// one gzip member whose trailer holds the whole size and CRC, as `gzip -t` and Python's gzip
+/// (single-member reading: zlib.decompressobj stops after one member) check.
+TEST_F(NiftiIo, LargeFieldIsOneGzipMemberReadBackExactly) {
+  ImageVolume grid;
+  grid.dims = {96, 80, 70};  // 6.4 MB of floats: two blocks and more
+  grid.affine_lps_m.topLeftCorner<3, 3>() = 1e-3 * Eigen::Matrix3d::Identity();
+  std::vector<float> u(3 * grid.voxel_count());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> value(-0.02f, 0.02f);
+  for (std::size_t n = 0; n < u.size(); ++n) u[n] = n % 7 == 0 ? 0.f : value(rng);
+  write_nifti_displacement(path("u.nii.gz"), grid, u);
+  std::vector<float> back;
+  read_nifti_displacement(path("u.nii.gz"), back);
+  ASSERT_EQ(back.size(), u.size());
+  for (std::size_t n = 0; n < u.size(); ++n) ASSERT_NEAR(back[n], u[n], 1e-6 * std::abs(u[n])) << n;
+  EXPECT_EQ(std::system(("gzip -t " + path("u.nii.gz")).c_str()), 0);
+  const std::string one_member =
+      "/usr/bin/python3 -c \"import sys,zlib; d=zlib.decompressobj(31); b=d.decompress(open(sys.argv[1],'rb').read()); "
+      "sys.exit(0 if d.eof and not d.unused_data and len(b)==352+4*" + std::to_string(u.size()) + " else 1)\" " +
+      path("u.nii.gz");
+  EXPECT_EQ(std::system(one_member.c_str()), 0);
+}
+
 // ---- reading files from elsewhere --------------------------------------------------------------
 
 TEST_F(NiftiIo, ScaleSlopeAndInterceptAreApplied) {

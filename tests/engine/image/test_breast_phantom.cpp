@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -155,6 +156,62 @@ TEST(BreastPhantom, GridIsAxisAlignedWithTheBreastCentredAtTheOrigin) {
 
   const std::vector<std::string> names{"air", "skin", "adipose", "fibroglandular", "muscle", "bone", "tumour"};
   EXPECT_EQ(p.label_names, names);
+}
+
+/// --dims and three spacings (a planning CT's field of view, scaled down): the grid has exactly
+/// those dims and edges, the breast mound in front of the chest wall (y < 0) has the default
+/// phantom's volume (to 2%: its edge texture is random) in the same place, the extra voxels in
+/// front of it are air (the chest-wall slab spans the whole field, as in a CT), and dims too small
+/// are refused naming the smallest that cover it.
+TEST(BreastPhantom, DimsAndPerAxisSpacingPlaceTheSamePhantomInALargerField) {
+  PhantomSpec base;
+  base.spacing_m = 0.004;
+  const Phantom small = make_breast_phantom(base);
+  PhantomSpec spec = base;
+  spec.spacing_xyz_m = Eigen::Vector3d(0.004, 0.004, 0.004);
+  spec.dims = {small.ct.dims[0] + 10, small.ct.dims[1] + 6, small.ct.dims[2] + 4};
+  const Phantom large = make_breast_phantom(spec);
+  EXPECT_EQ(large.ct.dims, spec.dims);
+  const Eigen::Matrix3d large_axes = large.ct.affine_lps_m.topLeftCorner<3, 3>();
+  EXPECT_TRUE(large_axes.isApprox(0.004 * Eigen::Matrix3d::Identity()));
+  std::size_t compared = 0, front_air = 0, front_outside = 0, body_small = 0, body_large = 0;
+  for (int k = 0; k < large.labels.dims[2]; ++k)
+    for (int j = 0; j < large.labels.dims[1]; ++j)
+      for (int i = 0; i < large.labels.dims[0]; ++i) {
+        const Eigen::Vector4d w = large.labels.affine_lps_m * Eigen::Vector4d(i, j, k, 1);
+        if (w.y() >= 0) continue;  // the chest wall: it fills each field
+        const Eigen::Vector4d h = small.labels.affine_lps_m.inverse() * w;
+        const Eigen::Vector3i n(int(std::lround(h.x())), int(std::lround(h.y())), int(std::lround(h.z())));
+        ASSERT_NEAR((h.head<3>() - n.cast<double>()).norm(), 0.0, 1e-9) << "voxel centres coincide";
+        const bool inside = (n.array() >= 0).all() && n.x() < small.labels.dims[0] && n.y() < small.labels.dims[1] &&
+                            n.z() < small.labels.dims[2];
+        const float label = large.labels.values[large.labels.linear_index(i, j, k)];
+        if (inside) {
+          body_small += small.labels.values[small.labels.linear_index(n.x(), n.y(), n.z())] != 0.f;
+          body_large += label != 0.f;
+          ++compared;
+        } else {
+          ++front_outside;
+          front_air += label == 0.f;
+        }
+      }
+  EXPECT_GT(compared, small.labels.voxel_count() / 3);
+  EXPECT_GT(body_small, 1000u);
+  EXPECT_NEAR(double(body_large), double(body_small), 0.02 * double(body_small));
+  EXPECT_GT(front_outside, 0u);
+  EXPECT_EQ(front_air, front_outside);
+
+  PhantomSpec planning = base;  // anisotropic: 2 × 2 × 5 mm
+  planning.spacing_xyz_m = Eigen::Vector3d(0.002, 0.002, 0.005);
+  const Phantom p = make_breast_phantom(planning);
+  const Eigen::Matrix3d axes = p.ct.affine_lps_m.topLeftCorner<3, 3>();
+  const Eigen::Matrix3d expected = Eigen::Vector3d(0.002, 0.002, 0.005).asDiagonal();
+  EXPECT_TRUE(axes.isApprox(expected));
+  PhantomSpec too_small = base;
+  too_small.dims = {small.ct.dims[0] - 1, small.ct.dims[1], small.ct.dims[2]};
+  const std::string error = error_text([&] { make_breast_phantom(too_small); });
+  EXPECT_NE(error.find("do not cover the phantom: it needs at least " + std::to_string(small.ct.dims[0])),
+            std::string::npos) << error;
 }
 
 TEST(BreastPhantom, BreastProtrudesAnteriorlyToItsDepth) {
