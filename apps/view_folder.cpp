@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <fstream>
-#include <toml++/toml.hpp>
+#include <toml++/toml.h>
 
 #include "engine/error.hpp"
 

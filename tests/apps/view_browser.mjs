@@ -4,11 +4,13 @@
 // EXPECTED.json: { "surface": { "vertices", "triangles", "bbox_min", "bbox_max" } | null,
 //                  "ct": { "dims" } | null, "tables": [titles the Numbers page must show] }
 // Prints one "ok"/"FAIL" line per check; exit status 1 when any failed.
-import puppeteer from 'puppeteer-core';
+import { createRequire } from 'node:module';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 
+// puppeteer-core is one of the page's npm packages (apps/web/node_modules, pinned by its lock file).
+const puppeteer = createRequire(new URL('../../apps/web/package.json', import.meta.url))('puppeteer-core');
 const [url, expectedFile, shots] = process.argv.slice(2);
 const expected = JSON.parse(readFileSync(expectedFile, 'utf8'));
 let failures = 0;
@@ -35,20 +37,28 @@ try {
   page.on('requestfailed', (r) => failedRequests.push(r.url()));
   page.on('response', (r) => { if (r.status() >= 400) failedRequests.push(`${r.status()} ${r.url()}`); });
 
-  /// Mean and standard deviation of a screenshot's grey levels (a blank canvas has none).
-  const pixelSpread = async (selector) => page.$eval(selector, (canvas) => {
-    const copy = document.createElement('canvas');
-    copy.width = 200; copy.height = Math.round((200 * canvas.height) / canvas.width) || 1;
-    const ctx = copy.getContext('2d');
-    ctx.drawImage(canvas, 0, 0, copy.width, copy.height);
-    const d = ctx.getImageData(0, 0, copy.width, copy.height).data;
-    let s = 0, s2 = 0; const n = d.length / 4; const grey = new Set();
-    for (let i = 0; i < d.length; i += 4) { const g = (d[i] + d[i + 1] + d[i + 2]) / 3; s += g; s2 += g * g; grey.add(Math.round(g)); }
-    const mean = s / n;
-    return { mean, std: Math.sqrt(Math.max(0, s2 / n - mean * mean)), levels: grey.size };
-  });
+  /// Mean and standard deviation of the grey levels of a screenshot of an element, and how many
+  /// distinct levels it has (a blank canvas has one). A screenshot, not a read of the canvas:
+  /// WebGL canvases without preserveDrawingBuffer read back empty after compositing.
+  const pixelSpread = async (selector) => {
+    const png = await (await page.$(selector)).screenshot({ encoding: 'base64' });
+    return page.evaluate(async (data) => {
+      const img = new Image();
+      img.src = `data:image/png;base64,${data}`;
+      await img.decode();
+      const copy = document.createElement('canvas');
+      copy.width = img.width; copy.height = img.height;
+      const ctx = copy.getContext('2d');
+      ctx.drawImage(img, 0, 0);
+      const d = ctx.getImageData(0, 0, copy.width, copy.height).data;
+      let s = 0, s2 = 0; const n = d.length / 4; const grey = new Set();
+      for (let i = 0; i < d.length; i += 4) { const g = (d[i] + d[i + 1] + d[i + 2]) / 3; s += g; s2 += g * g; grey.add(Math.round(g)); }
+      const mean = s / n;
+      return { mean, std: Math.sqrt(Math.max(0, s2 / n - mean * mean)), levels: grey.size };
+    }, png);
+  };
   const open = async (hash) => {
-    await page.goto(`${url.split('#')[0]}#${hash}`, { waitUntil: 'networkidle0', timeout: 60000 });
+    await page.goto(`${url.split('#')[0]}#${hash}`, { waitUntil: 'load', timeout: 60000 });
     await page.waitForFunction((id) => window.voxbreastView?.pages?.[id]?.ready || window.voxbreastView?.pages?.[id]?.error
       || window.voxbreastView?.errors?.length, { timeout: 60000 }, hash);
     await new Promise((r) => setTimeout(r, 800));  // a few animation frames

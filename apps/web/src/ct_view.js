@@ -3,7 +3,7 @@
 // maps as overlays, and a readout of every shown image's value at the cursor. The maps lie on
 // the undeformed CT grid, so they match the input CT; over the warped CT they show where the
 // tissue was, not where it went.
-import { Niivue, SLICE_TYPE } from '@niivue/niivue';
+import { Niivue, SLICE_TYPE, SHOW_RENDER } from '@niivue/niivue';
 import GUI from 'lil-gui';
 import { fmt } from './colour.js';
 
@@ -32,7 +32,8 @@ export async function showSlices(section, manifest, report) {
   const overlays = OVERLAYS.filter(([, file]) => has(file));
   if (has('labels.nii.gz') && !has('model_labels.nii.gz')) overlays.unshift(['tissue', 'labels.nii.gz', 'tissue', 'hsv']);
 
-  const nv = new Niivue({ backColor: [0.08, 0.09, 0.11, 1], show3Dcrosshair: false, isColorbar: false, crosshairColor: [1, 0.8, 0.2, 0.8] });
+  const nv = new Niivue({ backColor: [0.08, 0.09, 0.11, 1], show3Dcrosshair: false, isColorbar: false,
+    crosshairColor: [1, 0.8, 0.2, 0.6], crosshairWidth: 1, multiplanarShowRender: SHOW_RENDER.NEVER });
   await nv.attachToCanvas(canvas);
   const volumes = [
     ...backgrounds.map(([name, url], i) => ({ url, name: `${name}.nii.gz`, colormap: 'gray', opacity: i === 0 ? 1 : 0, cal_min: -160, cal_max: 240 })),
