@@ -133,6 +133,24 @@ else
   fail "view --host did not start"
 fi
 
+# --- --ct: the input CT as a DICOM series, converted to NIfTI for the page: the same grid and
+# values (within the 1 HU of rounding) as the phantom's own NIfTI copy
+if start_view "$out" --port 0 --ct "$root/data-samples/phantom/dicom"; then
+  base=${url%/}
+  if [[ $(status_of "$base/manifest.json") == 200 ]] && grep -q '"input_ct":"input/ct.nii.gz"' "$work/body" \
+     && [[ $(status_of "$base/input/ct.nii.gz") == 200 ]] && cp "$work/body" "$work/input_ct.nii.gz" \
+     && "$py" - "$work/input_ct.nii.gz" "$root/data-samples/phantom/ct.nii.gz" <<'PY'
+import sys, numpy as np, nibabel as nib
+a, b = (nib.load(p) for p in sys.argv[1:])
+assert a.shape == b.shape and np.allclose(a.affine, b.affine, atol=1e-3), (a.shape, b.shape, a.affine, b.affine)
+assert np.abs(np.asarray(a.dataobj, float) - np.asarray(b.dataobj, float)).max() <= 1.0
+PY
+  then pass "--ct DICOM series served as NIfTI with the CT's grid and values"
+  else fail "--ct DICOM series"; fi
+else
+  fail "view --ct did not start"
+fi
+
 # --- bad input: one line, non-zero exit
 for args in "$work/missing" "$out --host example.org" "$out --port 70000" "$out --export $out"; do
   # shellcheck disable=SC2086

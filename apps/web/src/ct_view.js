@@ -32,22 +32,22 @@ export async function showSlices(section, manifest, report) {
   const overlays = OVERLAYS.filter(([, file]) => has(file));
   if (has('labels.nii.gz') && !has('model_labels.nii.gz')) overlays.unshift(['tissue', 'labels.nii.gz', 'tissue', 'hsv']);
 
-  const nv = new Niivue({ backColor: [0.08, 0.09, 0.11, 1], show3Dcrosshair: false, isColorbar: false,
-    crosshairColor: [1, 0.8, 0.2, 0.6], crosshairWidth: 1, multiplanarShowRender: SHOW_RENDER.NEVER });
+  const nv = new Niivue({ backColor: [0.08, 0.09, 0.11, 1], show3Dcrosshair: false, isColorbar: false, showLegend: false,
+    crosshairColor: [1, 0.8, 0.2, 0.6], crosshairWidth: 0.4, crosshairWidthUnit: 'mm', multiplanarShowRender: SHOW_RENDER.NEVER });
   await nv.attachToCanvas(canvas);
   const volumes = [
     ...backgrounds.map(([name, url], i) => ({ url, name: `${name}.nii.gz`, colormap: 'gray', opacity: i === 0 ? 1 : 0, cal_min: -160, cal_max: 240 })),
     ...overlays.map(([, file], i) => ({ url: `data/${file}`, colormap: overlays[i][3], opacity: 0, name: file })),
   ];
   await nv.loadVolumes(volumes);
-  nv.setSliceType(SLICE_TYPE.MULTIPLANAR);
+  nv.setSliceType(SLICE_TYPE.AXIAL);
 
   let tissueNames = {};
   if (has('summary.json')) {
     const summary = await (await fetch('data/summary.json')).json();
     tissueNames = summary.image_outputs?.model_labels?.values ?? {};
   }
-  const params = { image: backgrounds[0][0], view: 'all three', window: Object.keys(WINDOWS)[1], overlay: 'none', opacity: 0.5 };
+  const params = { image: backgrounds[0][0], view: 'axial', window: Object.keys(WINDOWS)[1], overlay: 'none', opacity: 0.5 };
   const applyWindow = () => {
     const [level, width] = WINDOWS[params.window];
     for (let i = 0; i < backgrounds.length; ++i) {
@@ -89,5 +89,9 @@ export async function showSlices(section, manifest, report) {
   };
   readout.textContent = 'click a slice for values';
   if (manifest.input_ct_note) readout.insertAdjacentHTML('beforeend', `<br><span class="note">${manifest.input_ct_note}</span>`);
+  // The canvas is sized by its section, visible only once this tab is shown: size it again now
+  // and whenever the window changes.
+  nv.resizeListener();
+  window.addEventListener('resize', () => nv.resizeListener());
   report.volumes = nv.volumes.map((v) => ({ name: v.name, dims: Array.from(v.hdr.dims.slice(1, 4)) }));
 }

@@ -87,7 +87,7 @@ export async function showMeshes(section, manifest, report) {
   const centre = box.getCenter(new THREE.Vector3());
   const size = box.getSize(new THREE.Vector3()).length();
   controls.target.copy(centre);
-  camera.position.copy(centre).add(new THREE.Vector3(-0.9, -1.0, 0.45).normalize().multiplyScalar(1.8 * size));
+  camera.position.copy(centre).add(new THREE.Vector3(-1.0, -0.6, 0.35).normalize().multiplyScalar(1.8 * size));
   camera.near = size / 100;
   camera.far = size * 100;
 
@@ -209,6 +209,7 @@ export async function showMeshes(section, manifest, report) {
   resize();
   let last = 0;
   renderer.setAnimationLoop((t) => {
+    if (!section.classList.contains('active')) return;  // a hidden tab draws nothing
     if (params.play && frames.length && t - last > 250) {
       last = t;
       params.frame = (params.frame + 1) % frames.length;

@@ -56,7 +56,7 @@ const COLOURS = ['#4cc9f0', '#f72585', '#b5e48c', '#ffb703', '#9d4edd', '#ff6b35
 
 /// An SVG line plot of series [{ name, x, y }] with labelled axes.
 export function linePlot(series, xLabel, yLabel, { width = 520, height = 320 } = {}) {
-  const m = { l: 62, r: 12, t: 12, b: 42 };
+  const m = { l: 74, r: 12, t: 12, b: 42 };
   const xs = series.flatMap((s) => s.x).filter(Number.isFinite), ys = series.flatMap((s) => s.y).filter(Number.isFinite);
   const [x0, x1] = [Math.min(...xs), Math.max(...xs)], [y0, y1] = [Math.min(0, ...ys), Math.max(...ys)];
   const sx = (x) => m.l + ((x - x0) / (x1 - x0 || 1)) * (width - m.l - m.r);
