@@ -16,7 +16,7 @@ packages=(
   python3-dolfinx
   plastimatch elastix dicom3tools python3-meshio
   ccache
-  libcivetweb-dev chromium
+  libcivetweb-dev chromium curl
 )
 # node and npm bundle the page of `voxbreast view` (apps/web); Debian's own when none is on PATH.
 command -v node >/dev/null || packages+=(nodejs)
