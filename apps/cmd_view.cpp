@@ -129,18 +129,19 @@ std::string input_ct_url(const fs::path& file) {
 }
 
 struct Server {
+  fs::path root;  ///< the output folder (canonical), fixed at start: read by request threads
   fs::path web_dir;
   fs::path ct_override;
   fs::path ct_file;  ///< the input CT as NIfTI, or empty
   std::string ct_note;  ///< why the input CT is not shown, when reading it failed
   std::string token;  ///< required on every request when not empty
-  std::mutex mutex;   ///< guards folder and allowed (the manifest request rescans the folder)
+  std::mutex mutex;   ///< guards folder and allowed: the manifest request rescans the folder
   ViewFolder folder;
   std::set<std::string> allowed;
 
   nlohmann::json rescan() {
     std::lock_guard lock(mutex);
-    folder = scan_view_folder(folder.root, ct_override);
+    folder = scan_view_folder(root, ct_override);
     if (!ct_note.empty()) folder.input_ct_note = ct_note;
     allowed = {folder.files.begin(), folder.files.end()};
     nlohmann::json manifest = view_manifest(folder);
@@ -234,7 +235,7 @@ int handle_request(mg_connection* conn, void* data) {
   }
   if (path.rfind("/data/", 0) == 0) {
     const std::string relative = path.substr(6);
-    const auto file = resolve_inside(server.folder.root, relative);
+    const auto file = resolve_inside(server.root, relative);
     if (!file) return send_text(conn, 403, "text/plain", "refused: not a file inside the output folder\n");
     if (!server.is_allowed(relative)) return send_text(conn, 404, "text/plain", "not a file the page shows\n");
     return send_file(conn, *file, cookie);
@@ -352,6 +353,7 @@ Command add_view(CLI::App& app) {
     server.web_dir = web_assets_dir();
     server.ct_override = o->ct;
     server.folder = scan_view_folder(o->out_dir, o->ct);
+    server.root = server.folder.root;
     // A DICOM input CT is converted into this folder, removed when the command ends.
     struct Scratch {
       fs::path dir;

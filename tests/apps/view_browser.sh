@@ -2,8 +2,8 @@
 # voxbreast view end to end (docs/VIEW.md): a small CT simulation (the bundled phantom CT at a 6 mm
 # lattice, relaxation, surfaces and frames) shown in headless chromium, its rendered surface
 # compared with the .vtp read by VTK, its CT page with the warped CT's NIfTI header; the static
-# export served by a plain HTTP server; a probe-like and a sweep-like folder's numbers; path
-# traversal, methods and a missing token refused. Skips (77) only when chromium or the page's npm
+# export served by a plain HTTP server; a real probe's and sweep's numbers; the DICOM input CT
+# converted for the page; path traversal, methods and a missing token refused. Skips (77) only when chromium or the page's npm
 # packages are missing (scripts/setup.sh installs both).
 #   VOXBREAST_BIN=build/apps/voxbreast bash tests/apps/view_browser.sh .   [VIEW_SCREENSHOTS=docs/img]
 set -uo pipefail
