@@ -2,7 +2,8 @@
 // and checks what it rendered against expectations computed from the files by another reader.
 //   node view_browser.mjs URL EXPECTED.json [SCREENSHOT_DIR]
 // EXPECTED.json: { "surface": { "vertices", "triangles", "bbox_min", "bbox_max" } | null,
-//                  "ct": { "dims" } | null, "tables": [titles the Numbers page must show] }
+//                  "ct": { "dims" } | null, "tables": [titles the Numbers page must show],
+//                  "live": true for a `voxbreast serve` page }
 // Prints one "ok"/"FAIL" line per check; exit status 1 when any failed.
 import { createRequire } from 'node:module';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
@@ -96,7 +97,16 @@ try {
     check(/warped CT: -?\d+ HU/.test(readout), 'cursor readout shows HU', readout);
     if (shots) await page.screenshot({ path: join(shots, 'view_ct.png') });
   }
-  {
+  if (expected.live) {
+    const { report, errors } = await open('live');
+    check(report?.ready && errors.length === 0, 'Live page connects', JSON.stringify({ report, errors }));
+    await new Promise((r) => setTimeout(r, 1500));
+    const later = await page.evaluate(() => window.voxbreastView.pages.live);
+    check(later.frames > 1 && later.vertexCount > 0, `Live page shows streamed frames (${later.frames} frames, step ${later.step})`, JSON.stringify(later));
+    const px = await pixelSpread('#page-live canvas');
+    check(px.std > 8 && px.levels > 20, 'Live canvas is not blank', JSON.stringify(px));
+    if (shots) await page.screenshot({ path: join(shots, 'view_live.png') });
+  } else {
     const { report, errors } = await open('numbers');
     check(report?.ready && errors.length === 0, 'Numbers page loads', JSON.stringify({ report, errors }));
     for (const t of expected.tables ?? []) check(report?.tables?.includes(t), `Numbers page shows ${t}`, JSON.stringify(report?.tables));

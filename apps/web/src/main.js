@@ -4,6 +4,7 @@
 import { showMeshes } from './mesh_view.js';
 import { showSlices } from './ct_view.js';
 import { showNumbers } from './numbers.js';
+import { showLive } from './live_view.js';
 
 const state = (window.voxbreastView = { errors: [], pages: {} });
 window.addEventListener('error', (e) => state.errors.push(String(e.message)));
@@ -28,9 +29,10 @@ async function main() {
   document.getElementById('title').textContent = `VoxBreast · ${manifest.title} · ${manifest.kind}`;
 
   const pages = [];
+  if (manifest.live) pages.push(['live', 'Live', showLive]);
   if (manifest.files.some((f) => f.endsWith('.vtp'))) pages.push(['3d', '3D', showMeshes]);
   if (has('warped_ct.nii.gz') || has('ct.nii.gz') || manifest.input_ct) pages.push(['ct', 'CT', showSlices]);
-  pages.push(['numbers', 'Numbers', showNumbers]);
+  if (!manifest.live) pages.push(['numbers', 'Numbers', showNumbers]);
 
   const nav = document.getElementById('tabs');
   const main = document.getElementById('pages');
