@@ -223,6 +223,9 @@ int run_serve(const ServeOptions& o) {
       for (int c = 0; c < 3; ++c) positions.push_back(float(1000 * rest[3 * mesh.element_of_vertex[v] + c]));
     live.mesh_message = nlohmann::json{{"type", "mesh"}, {"triangles", triangles}, {"rest_mm", positions},
                                        {"postures", posture_names()}, {"elements", n}, {"dt_s", sim.dt_s()},
+                                       {"gravity_m_s2", {scene.gravity.acceleration_m_s2.x(), scene.gravity.acceleration_m_s2.y(),
+                                                         scene.gravity.acceleration_m_s2.z()}},
+                                       {"posture", scene.gravity.posture},
                                        {"steps_per_frame", std::max(1, scene.solver.check_every)}}
                             .dump();
   }

@@ -50,6 +50,8 @@ export async function showLive(section, manifest, report) {
         controls.target.copy(centre);
         camera.position.copy(centre).add(new THREE.Vector3(-1.0, -0.6, 0.35).normalize().multiplyScalar(1.8 * size));
         camera.near = size / 100; camera.far = size * 100; camera.updateProjectionMatrix();
+        [params.gx, params.gy, params.gz] = message.gravity_m_s2;  // the scene's gravity at start
+        params.posture = message.posture;
         addControls(message.postures);
         report.vertexCount = rest.length / 3;
         resolve();
