@@ -130,7 +130,7 @@ int handle_page(mg_connection* conn, void* data) {
 int ws_connect(const mg_connection* conn, void* data) {
   auto& live = *static_cast<Live*>(data);
   if (live.token.empty()) return 0;
-  return web::same_token(web::request_token(const_cast<mg_connection*>(conn)), live.token) ? 0 : 1;  // 1: refuse
+  return web::same_token(web::request_token(conn), live.token) ? 0 : 1;  // 1: refuse
 }
 
 void ws_ready(mg_connection* conn, void* data) {

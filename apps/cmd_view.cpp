@@ -7,12 +7,10 @@
 // files and a manifest of them; nothing else on the machine is reachable through it.
 #include <unistd.h>
 
-#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <memory>
 #include <mutex>
-#include <random>
 #include <set>
 
 #include "apps/commands.hpp"

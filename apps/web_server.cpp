@@ -151,7 +151,7 @@ int send_file(mg_connection* conn, const fs::path& file, const std::string& cook
 }
 
 /// The token of a request: ?token=, the cookie the page got with it, or "Authorization: Bearer".
-std::string request_token(mg_connection* conn) {
+std::string request_token(const mg_connection* conn) {
   const mg_request_info* ri = mg_get_request_info(conn);
   char value[128] = {};
   if (ri->query_string && mg_get_var(ri->query_string, std::strlen(ri->query_string), "token", value, sizeof value) > 0)

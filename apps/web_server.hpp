@@ -19,7 +19,7 @@ std::string random_token();
 /// Compares in time independent of where the strings differ.
 bool same_token(const std::string& a, const std::string& b);
 /// The token of a request: ?token=, the cookie the page got with it, or "Authorization: Bearer".
-std::string request_token(mg_connection* conn);
+std::string request_token(const mg_connection* conn);
 /// The Set-Cookie value that carries `token` for the page's later requests.
 std::string token_cookie(const std::string& token);
 
