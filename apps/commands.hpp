@@ -27,5 +27,7 @@ Command add_probe(CLI::App& app);
 Command add_fit(CLI::App& app);
 Command add_cache(CLI::App& app);
 Command add_export(CLI::App& app);
+Command add_view(CLI::App& app);
+Command add_serve(CLI::App& app);
 
 }  // namespace vb::app

@@ -9,6 +9,8 @@
 //   voxbreast probe data-samples/palpation/scene.toml --out out/palpation
 //   voxbreast cache --clear
 //   voxbreast export data-samples/phantom/scene.toml --feb out/phantom.feb
+//   voxbreast view out/phantom
+//   voxbreast serve data-samples/phantom/scene.toml
 // Every subcommand has --help. Errors print one line naming the problem and exit non-zero (2 for
 // a misused command line, 4 for a run that went unstable or
 // cannot keep its contact, 1 for everything else; simulate exits 3
@@ -33,7 +35,8 @@ int main(int argc, char** argv) {
                                        vb::app::add_bench(app), vb::app::add_phantom(app),
                                        vb::app::add_sweep(app), vb::app::add_haptic(app),
                                        vb::app::add_fit_curve(app), vb::app::add_probe(app), vb::app::add_fit(app),
-                                       vb::app::add_cache(app), vb::app::add_export(app)};
+                                       vb::app::add_cache(app), vb::app::add_export(app),
+                                       vb::app::add_view(app), vb::app::add_serve(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -16,7 +16,11 @@ packages=(
   python3-dolfinx
   plastimatch elastix dicom3tools python3-meshio
   ccache
+  libcivetweb-dev chromium curl
 )
+# node and npm bundle the page of `voxbreast view` (apps/web); Debian's own when none is on PATH.
+command -v node >/dev/null || packages+=(nodejs)
+command -v npm >/dev/null || packages+=(npm)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -24,12 +28,19 @@ for p in "${packages[@]}"; do
 done
 if ((${#missing[@]} == 0)); then
   echo "setup: all ${#packages[@]} packages already installed"
-  exit 0
+else
+  sudo_cmd=()
+  [[ $(id -u) -ne 0 ]] && sudo_cmd=(sudo)
+  echo "setup: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo_cmd[@]}" apt-get update -qq
+  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-sudo_cmd=()
-[[ $(id -u) -ne 0 ]] && sudo_cmd=(sudo)
-echo "setup: installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-"${sudo_cmd[@]}" apt-get update -qq
-"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# The page's JavaScript packages, exactly as package-lock.json pins them. Puppeteer drives the
+# system chromium in the browser tests and must not download a browser of its own.
+web=$(cd "$(dirname "$0")/../apps/web" && pwd)
+if [[ ! -d $web/node_modules ]] || [[ $web/package-lock.json -nt $web/node_modules/.package-lock.json ]]; then
+  echo "setup: npm ci in apps/web"
+  (cd "$web" && PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error)
+fi
