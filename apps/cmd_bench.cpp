@@ -44,6 +44,7 @@ struct BenchOptions {
   std::vector<int> haptic_elements = {10000};  ///< haptic-rate blocks (about this many elements)
   double haptic_seconds = 3;
   std::vector<std::string> laws, integrators, scenes;
+  std::string plan;  ///< throughput: launch-plan overrides, "key=value,..." (engine/sim/launch_plan.hpp)
 };
 
 std::string utc_date() {
@@ -117,6 +118,7 @@ nlohmann::json run_haptic_bench(const ClContext& cl, const BenchOptions& o) {
 
 int run_bench(BenchOptions o) {
   const auto start = std::chrono::steady_clock::now();
+  const PlanOverrides plan = PlanOverrides::parse(o.plan);  // a bad override is refused before any output
   const OutputDir output_dir(o.out);
   if (o.phantom.empty()) {
     if (std::filesystem::exists(kDefaultPhantom)) o.phantom = kDefaultPhantom;
@@ -155,6 +157,7 @@ int run_bench(BenchOptions o) {
         o.volume_predictor == "projection" ? VolumeSpec::Predictor::Projection : VolumeSpec::Predictor::Pressure;
     t.profile = o.profile;
     t.cube_dashpot_ratio = o.cube_dashpot_ratio;
+    t.plan = plan;
     if (breast_any) {
       require(!o.phantom.empty(), "--breast, --breast-large and --breast-elements need the phantom's scene",
               "bench --breast", "give --phantom");
@@ -256,6 +259,9 @@ Command add_bench(CLI::App& app) {
                                          "enqueue time, the device's time alone, the timed step) and the device time "
                                          "and launches per step of each kernel (a second run of each block on a "
                                          "profiling queue)");
+  sub->add_option("--plan", o->plan,
+                  "throughput: launch-plan overrides to compare schedules on a device, e.g. lanes=0,step_list=1 "
+                  "(keys in engine/sim/launch_plan.hpp; docs/PERFORMANCE.md)");
   sub->add_flag("--dry-run", o->dry_run, "list the scenes and cases without running them");
   sub->add_flag("--haptic", o->haptic, "haptic rate: a probe pressing a block, force output at 1 kHz (with "
                                        "--no-study: only this)");
