@@ -236,9 +236,9 @@ DeviceAlone device_time_per_step(const ClContext& cl, Simulator& sim, std::int64
 /// NVIDIA the profiling events make the host the bottleneck, so the profiled step is slower than
 /// the timed one; the per-kernel times remain device times.
 void print_kernel_profile(const ClContext& cl, const Scene& scene, const Lattice& lattice, const ElementArrays& el,
-                          double steps_per_s) {
+                          double steps_per_s, const PlanOverrides& plan) {
   const ClContext profiling(cl.info, true);
-  Simulator sim(scene, lattice, el, profiling);
+  Simulator sim(scene, lattice, el, profiling, plan);
   sim.advance(3);
   sim.check();
   const std::int64_t steps = std::max<std::int64_t>(20, std::int64_t(0.2 * steps_per_s));
@@ -331,7 +331,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
     }
     scene.volume.predictor = o.volume_predictor;
     const ElementArrays el = make_element_arrays(scene, lattice);
-    Simulator sim(scene, lattice, el, cl);
+    Simulator sim(scene, lattice, el, cl, o.plan);
     const double sps = time_steps(sim, target_s);
     const std::size_t n = lattice.element_count();
     // A step moves the bytes of the elements it steps: held ones are only read as neighbours
@@ -402,7 +402,7 @@ ThroughputResult run_throughput(const ClContext& cl, const ThroughputOptions& o)
       row["host_enqueue_us_per_step"] = 1e6 * host_s;
       row["device_alone_us_per_step"] = device.seconds_per_step ? nlohmann::json(1e6 * *device.seconds_per_step) : nlohmann::json();
       row["device_alone_host_ahead"] = device.host_ahead;
-      print_kernel_profile(cl, scene, lattice, el, sps);
+      print_kernel_profile(cl, scene, lattice, el, sps, o.plan);
     }
     rows.push_back(row);
   }

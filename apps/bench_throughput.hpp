@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "engine/scene/scene.hpp"
+#include "engine/sim/launch_plan.hpp"
 #include "engine/sim/opencl_runtime.hpp"
 
 namespace vb::app {
@@ -27,6 +28,7 @@ struct ThroughputOptions {
   /// one-launch step pay, docs/PERFORMANCE.md, "Launches per step")
   std::vector<long> breast_elements;
   std::vector<std::string> breast_integrators{"heun"};  ///< those models' integrators (bench knob names)
+  PlanOverrides plan;  ///< launch-plan overrides of every timed model (--plan)
 };
 
 struct ThroughputResult {

@@ -48,6 +48,7 @@ struct BenchOptions {
   double haptic_seconds = 3;
   std::vector<std::string> laws, integrators, scenes;
   std::vector<std::string> jobs;  ///< scenes run end to end like `simulate`, each phase timed
+  std::string plan;  ///< throughput: launch-plan overrides, "key=value,..." (engine/sim/launch_plan.hpp)
 };
 
 std::string utc_date() {
@@ -162,6 +163,7 @@ nlohmann::json run_job_bench(const ClContext& cl, const BenchOptions& o) {
 
 int run_bench(BenchOptions o) {
   const auto start = std::chrono::steady_clock::now();
+  const PlanOverrides plan = PlanOverrides::parse(o.plan);  // a bad override is refused before any output
   const OutputDir output_dir(o.out);
   if (o.phantom.empty()) {
     if (std::filesystem::exists(kDefaultPhantom)) o.phantom = kDefaultPhantom;
@@ -205,6 +207,7 @@ int run_bench(BenchOptions o) {
         o.volume_predictor == "projection" ? VolumeSpec::Predictor::Projection : VolumeSpec::Predictor::Pressure;
     t.profile = o.profile;
     t.cube_dashpot_ratio = o.cube_dashpot_ratio;
+    t.plan = plan;
     if (breast_any) {
       require(!o.phantom.empty(), "--breast, --breast-large and --breast-elements need the phantom's scene",
               "bench --breast", "give --phantom");
@@ -306,10 +309,16 @@ Command add_bench(CLI::App& app) {
                                          "enqueue time, the device's time alone, the timed step) and the device time "
                                          "and launches per step of each kernel (a second run of each block on a "
                                          "profiling queue)");
+<<<<<<< HEAD
   sub->add_option("--job", o->jobs,
                   "run this scene end to end like 'simulate' (into OUT/job_N/), timing each phase and the image "
                   "outputs' peak memory; repeatable")
       ->check(CLI::ExistingFile);
+=======
+  sub->add_option("--plan", o->plan,
+                  "throughput: launch-plan overrides to compare schedules on a device, e.g. lanes=0,step_list=1 "
+                  "(keys in engine/sim/launch_plan.hpp; docs/PERFORMANCE.md)");
+>>>>>>> plan
   sub->add_flag("--dry-run", o->dry_run, "list the scenes and cases without running them");
   sub->add_flag("--haptic", o->haptic, "haptic rate: a probe pressing a block, force output at 1 kHz (with "
                                        "--no-study: only this)");

@@ -109,7 +109,7 @@ VB_INLINE real4 correct_update(uint e, real4* ui, real4 vi, real4 up, real4 vp, 
   return vn;
 }
 
-// VB_SPLIT > 1 (Heun on GPUs, small hyperelastic models; VOXBREAST_FORCE_SPLIT): each element's 26
+// VB_SPLIT > 1 (Heun on GPUs, small hyperelastic models; --plan force_split): each element's 26
 // connections are summed by VB_SPLIT work-items, a group of VB_SPLIT_WG holding VB_SPLIT_PER
 // elements, part p in work-items p·VB_SPLIT_PER + i (whole warps per part, so the range of
 // connections is uniform in a warp). Part 0 adds the other parts' sums from local memory in a fixed

@@ -20,7 +20,7 @@
 #endif
 #define VB_GRID_SPIN_LIMIT (1u << 24)
 
-// -DVB_PERSISTENT_TRACE=1 (VOXBREAST_PERSISTENT_TRACE=1): work-group 0 stamps the GPU's ns clock at
+// -DVB_PERSISTENT_TRACE=1 (--plan persistent_trace=1): work-group 0 stamps the GPU's ns clock at
 // the start and after every grid barrier into sync[2 + k], which the host prints at each check.
 #if VB_PERSISTENT_TRACE
 inline void trace_stamp(volatile global uint* sync, uint k) {

@@ -7,12 +7,12 @@
 # With a reference build (.device-pkgs/ref.tar.xz holding bin/voxbreast of another commit, made by
 # `bash scripts/perf_gpu.sh ref BUILD_DIR` here) the same rows run with it too, interleaved with
 # this build's, so that one call gives an A/B on one device.
-# Switches the A/B rows also try (docs/PERFORMANCE.md, "Tools"):
-#   VOXBREAST_FORCE_SPLIT=1|2|4      work-items per element in Heun's force passes (GPU default 2
+# Launch-plan overrides the A/B rows also try (bench --plan; engine/sim/launch_plan.hpp):
+#   force_split=1|2|4                work-items per element in Heun's force passes (GPU default 2
 #                                    for hyperelastic models up to 98,304 elements)
 #   --volume-predictor projection    the volume rows with Heun's predicted stage projected
-#   VOXBREAST_STRESS_PAIR=0          both element stresses of a Heun step in two launches
-#   VOXBREAST_PERSISTENT=0|1         Heun's step as one launch with grid barriers (NVIDIA default
+#   stress_pair=0                    both element stresses of a Heun step in two launches
+#   persistent=0|1                   Heun's step as one launch with grid barriers (NVIDIA default
 #                                    for spring models up to 45,056 elements; the 36k rows run
 #                                    the default and =0)
 #   here:   cmake --build build --target voxbreast test_physics && bash scripts/gpu_run.sh prepare
@@ -34,7 +34,7 @@ if [[ -f .device-pkgs/ref.tar.xz ]]; then
   ref=$(mktemp -d) && tar -C "$ref" -xJf .device-pkgs/ref.tar.xz && ref=$ref/bin/voxbreast
 fi
 bench=(bench --device gpu --quick --no-study --profile)
-# name, binary, then bench arguments; the environment of the call applies
+# name, binary, then bench arguments
 # (all rows into one file: the device tool brings back few files)
 row() {
   local name=$1 bin=$2; shift 2
@@ -55,21 +55,18 @@ if [[ "${1:-}" == target ]]; then
     [[ -n "$ref" ]] && row "ref_r$round" "$ref" --breast --sizes 33 --laws ogden --volume
   done
   # the projection in one launch (volume_project) instead of two
-  VOXBREAST_VOLUME_LAUNCHES=1 row breast_project1 voxbreast --breast --sizes 33 --laws ogden --volume
+  row breast_project1 voxbreast --breast --sizes 33 --laws ogden --volume --plan volume_launches=1
   gpu_tests
   grep -hE '^== |^(block|breast)(_volume)? +[0-9]+ elements|device alone|error' "$out/rows.txt" | tee "$out/summary.txt"
   exit
 fi
 
 gpu_tests
-# the split force passes (four work-items per element, any law) against the host
-VOXBREAST_DEVICE=gpu VOXBREAST_FORCE_SPLIT=4 run test_physics --gtest_filter='*KernelSteps*:HyperelasticKernels.MatchHost*' \
-  2>&1 | grep -E '^\[ *(OK|FAILED|PASSED) *\]|Failure' | tee "$out/gpu_tests_split4.txt"
 
 for round in 1 2; do
   row "36k_r$round" voxbreast --sizes 33 --laws linear ogden --volume
   # one launch per pass instead of the persistent step (kernels/persistent.cl)
-  VOXBREAST_PERSISTENT=0 row "36k_launches_r$round" voxbreast --sizes 33 --laws linear ogden --volume
+  row "36k_launches_r$round" voxbreast --sizes 33 --laws linear ogden --volume --plan persistent=0
   # Heun's predicted stage projected instead of under the lagged pressure (docs/PERFORMANCE.md, "Volume projection forms")
   row "36k_projection_r$round" voxbreast --sizes 33 --laws ogden --volume --volume-predictor projection
   [[ -n "$ref" ]] && row "36k_ref_r$round" "$ref" --sizes 33 --laws linear ogden --volume
@@ -77,9 +74,9 @@ done
 # the breast phantom at 3.2 mm (34,961 elements, a third of them moving) next to the cube
 row 36k_breast voxbreast --breast --sizes 33 --laws linear neo-hookean ogden --volume
 # both of Heun's element stresses in two launches instead of one (docs/PERFORMANCE.md, "Volume projection forms")
-VOXBREAST_STRESS_PAIR=0 row 36k_breast_nopair voxbreast --breast --sizes 33 --laws ogden --volume
-VOXBREAST_FORCE_SPLIT=1 row 36k_split1 voxbreast --sizes 33 --laws ogden --volume
-VOXBREAST_FORCE_SPLIT=4 row 36k_split4 voxbreast --sizes 33 --laws ogden --volume
+row 36k_breast_nopair voxbreast --breast --sizes 33 --laws ogden --volume --plan stress_pair=0
+row 36k_split1 voxbreast --sizes 33 --laws ogden --volume --plan force_split=1
+row 36k_split4 voxbreast --sizes 33 --laws ogden --volume --plan force_split=4
 row 1.5M voxbreast --sizes 115 --laws ogden
 [[ -n "$ref" ]] && row 1.5M_ref "$ref" --sizes 115 --laws ogden
 grep -hE '^== |^(block|breast)(_volume)? +[0-9]+ elements' "$out/rows.txt" | tee "$out/summary.txt"

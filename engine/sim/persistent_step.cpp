@@ -1,7 +1,6 @@
 #include "engine/sim/persistent_step.hpp"
 
 #include <algorithm>
-#include <cstdlib>
 #include <exception>
 #include <string>
 
@@ -28,27 +27,9 @@ void PersistentPlan::fit_registers(int registers, std::size_t compute_units) {
   groups = std::min(groups, std::max<std::size_t>(1, groups_per_unit_by_registers(registers, kWorkGroup) * compute_units));
 }
 
-PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, bool hyperelastic, std::size_t elements,
-                                    int force_split, std::size_t max_elements) {
-  PersistentPlan plan;
-  const bool possible = eligible && nvidia_ptx(device) && device.compute_units > 0;
-  plan.on = possible && !hyperelastic && elements <= max_elements;
-  if (const char* env = std::getenv("VOXBREAST_PERSISTENT")) plan.on = possible && std::atoi(env) == 1;
-  if (!plan.on) return plan;
-  constexpr std::size_t kMinPerUnit = 2, kMaxPerUnit = 6;
-  const std::size_t per_block = PersistentPlan::kWorkGroup / std::size_t(std::max(force_split, 1));
-  const std::size_t blocks = (elements + per_block - 1) / per_block;
-  std::size_t per_unit =
-      std::clamp((blocks + device.compute_units - 1) / device.compute_units, kMinPerUnit, kMaxPerUnit);
-  if (const char* env = std::getenv("VOXBREAST_PERSISTENT_GROUPS"))  // per compute unit, to compare
-    per_unit = std::clamp<std::size_t>(std::size_t(std::max(std::atoi(env), 1)), 1, 8);
-  const char* trace = std::getenv("VOXBREAST_PERSISTENT_TRACE");
-  plan.trace = trace && std::atoi(trace) == 1;
-  plan.groups = per_unit * device.compute_units;
-  if (const char* env = std::getenv("VOXBREAST_PERSISTENT_GROUP_LIMIT"))  // tests: several blocks per group
-    plan.groups = std::clamp<std::size_t>(std::size_t(std::max(std::atoi(env), 1)), 1, plan.groups);
-  plan.max_registers = int(std::min<std::size_t>(255, kRegistersPerUnit / (PersistentPlan::kWorkGroup * per_unit) / 8 * 8));
-  return plan;
+int persistent_register_cap(std::size_t groups_per_unit) {
+  const std::size_t per_unit = std::max<std::size_t>(groups_per_unit, 1);
+  return int(std::min<std::size_t>(255, kRegistersPerUnit / (PersistentPlan::kWorkGroup * per_unit) / 8 * 8));
 }
 
 int registers_in_build_log(const std::string& log, const std::string& kernel) {

@@ -15,7 +15,7 @@ struct PersistentPlan {
   bool on = false;
   std::size_t groups = 0;   ///< work-groups of kWorkGroup work-items, all resident (fit_registers)
   int max_registers = 0;    ///< per work-item, so that groups / compute units fit on one
-  bool trace = false;       ///< VOXBREAST_PERSISTENT_TRACE=1: pass times printed at each check
+  bool trace = false;       ///< pass times printed at each check (PlanOverrides::persistent_trace)
   static constexpr std::size_t kWorkGroup = 128;  ///< VB_PERSISTENT_WG
   /// build options: -DVB_PERSISTENT=0|1 and, when on, NVIDIA's register cap and -cl-nv-verbose (the
   /// build log then says how many registers the kernel uses: registers_in_build_log)
@@ -26,17 +26,10 @@ struct PersistentPlan {
   void fit_registers(int registers, std::size_t compute_units);
 };
 
-/// Heun scenes without triangle contact or folded volume projections, on an NVIDIA GPU: by default
-/// spring models up to `max_elements` (VOXBREAST_PERSISTENT=0 turns it off, =1 on for any size and
-/// for hyperelastic models, where it measured slower: docs/PERFORMANCE.md, "One-launch persistent step"). Groups per
-/// compute unit: enough for one block of elements per group in the widest pass (force_split
-/// work-items per element), 2 to 6; the register cap 65,536 / (128 · groups per unit), in
-/// multiples of 8, is what NVIDIA's register file then lets reside if the compiler keeps to it
-/// (after the build: PersistentPlan::fit_registers). VOXBREAST_PERSISTENT_GROUPS=k
-/// sets the groups per compute unit (1–8), to compare; VOXBREAST_PERSISTENT_GROUP_LIMIT=N at most N
-/// groups in all, so that tests make each group walk several blocks.
-PersistentPlan plan_persistent_step(const DeviceInfo& device, bool eligible, bool hyperelastic, std::size_t elements,
-                                    int force_split, std::size_t max_elements);
+/// The register cap per work-item when `groups_per_unit` groups of kWorkGroup work-items share one
+/// NVIDIA compute unit: 65,536 / (128 · groups per unit), in multiples of 8, at most 255. (When the
+/// plan takes the one-launch step and how many groups it launches: launch_plan.cpp.)
+int persistent_register_cap(std::size_t groups_per_unit);
 
 /// The registers per work-item that NVIDIA's compiler reports for `kernel` in a build log made
 /// with -cl-nv-verbose ("Compiling entry function 'kernel'", then "Used N registers"); -1 where

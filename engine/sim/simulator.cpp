@@ -54,7 +54,8 @@ std::vector<cl_uint> elements_read_by_free(const Lattice& lattice, const std::ve
 
 }  // namespace
 
-Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const ClContext& cl)
+Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementArrays& el, const ClContext& cl,
+                     const PlanOverrides& overrides)
     : scene_(scene),
       lattice_(lattice),
       cl_(cl),
@@ -117,8 +118,10 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   rest_offsets_ = scene.reference_state.active;
   hyper_ = el.hyperelastic;
   biphasic_ = el.biphasic;
-  plan_launches(scene, el, cl);
-  if (stress_pair_) device_bytes_ += n_ * 4 * 4 * real_size_;  // the predicted stage's Q rows and C
+  const PlanInputs plan_in = plan_inputs(scene, el.hyperelastic, el.biphasic, n_, el.held_count, tri_contact_, cl.info,
+                                         cl.info.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>());
+  plan_ = choose_launch_plan(plan_in, overrides);
+  if (plan_.stress_pair) device_bytes_ += n_ * 4 * 4 * real_size_;  // the predicted stage's Q rows and C
   device_bytes_ += 2 * n_ * real_size_;  // the check's per-element scales
   require_fits_device(device_bytes_, n_, cells, el.hyperelastic, scene, cl.info);
 
@@ -132,7 +135,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   const std::size_t frame_bytes = (rest_offsets_ && hyper_ ? 3 * n_ : 1) * 4 * real_size_;
   if (rest_offsets_) device_bytes_ += offset_bytes + (hyper_ ? frame_bytes : 0);
   make_model_arena(el, grid, cell_of, offset_bytes);
-  plan_pred_packing(scene, el, cl);  // after the short loop's marks
+  plan_.pred_packed = choose_pred_packing(plan_, plan_in, uniform_elements_, overrides);  // after the short loop's marks
   for (const IndenterSpec& ind : scene.indenters) motion_.push_back(starting_motion(ind));  // before the obstacle table
   path_segment_.assign(scene.indenters.size(), std::size_t(-1));
   // the volume constraint's surface elements, one work-item each (kernels/volume.cl: the volume
@@ -181,16 +184,14 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_INDENTERS=" + std::to_string(scene.indenters.size());
   options += " -DVB_CHECK_SLOTS=" + std::to_string(check_slots_);
   options += " -DVB_RSQRT=" + std::to_string(cl.info.is_gpu);
-  options += " -DVB_UNIFORM_PATH=" + std::to_string(uniform_path_);
-  options += " -DVB_PRED_PACKED=" + std::to_string(pred_packed_);
-  options += " -DVB_CORRECT_REVERSE=" + std::to_string(correct_reverse_) +
+  options += " -DVB_CORRECT_REVERSE=" + std::to_string(plan_.correct_reverse) +
              " -DVB_REVERSE_BLOCK=" + std::to_string(std::max<std::size_t>(1, cl.info.simd_width)) + "u";
   // Denormal floats (< 1.2e-38: nothing in m, N, Pa) flushed to zero on GPUs: NVIDIA's rsqrt,
   // rcp and sqrt then skip their denormal fix-up: the 1.5M linear Heun float step 3-4.5% shorter
   // on the H200 (device time).
   // Not for the one-launch step, which it made 4% slower (36k linear), nor on CPUs, whose tests'
   // references keep IEEE denormals (docs/PERFORMANCE.md, "Denormals and the power cap").
-  if (cl.info.is_gpu && !persistent_.on) options += " -cl-denorms-are-zero";
+  if (cl.info.is_gpu && !plan_.persistent.on) options += " -cl-denorms-are-zero";
   // Torus contact settles only with correctly rounded float division and square root: with
   // NVIDIA's default ones (about 2 ulp) a dome squeezed by an inflating torus kept a residual of
   // 6.6e-4 for 60,000 steps, against 1,600 steps to 6e-7 with this option, as on PoCL
@@ -208,32 +209,19 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
                       kVolumeSlots * kVolumeGpuWorkGroup * real_size_ + 64 <= local_bytes;
     volume_wg_ = wide ? kVolumeGpuWorkGroup : std::size_t(kCheckWorkGroup);
     options += " -DVB_VOLUME_WG=" + std::to_string(volume_wg_);
-    // The volume gradient's incident triangles as element pairs (two dependent loads per term
-    // instead of four, kernels/volume.cl); VOXBREAST_VOLUME_PAIRS=0 keeps corner indices, to compare.
-    const char* pairs = std::getenv("VOXBREAST_VOLUME_PAIRS");
-    volume_pairs_ = !(pairs && std::atoi(pairs) == 0);
-    options += " -DVB_VOLUME_PAIRS=" + std::to_string(volume_pairs_);
   }
-  options += " -DVB_VOLUME_FOLD=" + std::to_string(volume_ && volume_launches_ == 0);
-  options += " -DVB_SPLIT=" + std::to_string(force_split_);
-  options += " -DVB_LANES=" + std::to_string(lanes_);
-  options += " -DVB_STEP_LIST=" + std::to_string(step_list_) + " -DVB_STEP_LIST_AT=" + std::to_string(step_list_at_) + "u";
+  options += " -DVB_STEP_LIST=" + std::to_string(plan_.step_list) + " -DVB_STEP_LIST_AT=" + std::to_string(step_list_at_) + "u";
   options += " -DVB_NV_PTX=" + std::to_string(nvidia_ptx(cl.info));
-  options += persistent_.options();
-  options += " -DVB_VOLUME_LAG=" + std::to_string(volume_lag_);
-  options += " -DVB_STRESS_PAIR=" + std::to_string(stress_pair_);
+  options += plan_.build_options(volume_);
   {
-    // One work-item per element (or listed element) in groups of default_step_work_group on GPUs
-    // (step_work_group.hpp: 256 from 131,072 elements); PoCL picks its own unless
-    // VOXBREAST_STEP_WG asks (not for the lanes kernels, make_lane_args: their own range).
-    const std::size_t per = kSplitWorkGroup / std::size_t(force_split_);
-    std::size_t wg = cl.info.is_gpu ? default_step_work_group(n_) : 0;
-    if (const char* env = std::getenv("VOXBREAST_STEP_WG"); env && force_split_ == 1 && !lanes_)
-      wg = step_work_group_override(env, cl.info.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>());
-    const std::size_t items = step_list_ ? std::max<std::size_t>(1, step_list_n_) : n_, rounding = wg ? wg : kStepWorkGroup;
-    step_global_ = force_split_ > 1 ? cl::NDRange((n_ + per - 1) / per * kSplitWorkGroup)
+    // One work-item per element (or listed element) in groups of the plan's size (0: the runtime
+    // picks; the lanes kernels set their own range in make_lane_args).
+    const std::size_t per = kSplitWorkGroup / std::size_t(plan_.force_split);
+    const std::size_t wg = plan_.step_work_group;
+    const std::size_t items = plan_.step_list ? std::max<std::size_t>(1, step_list_n_) : n_, rounding = wg ? wg : kStepWorkGroup;
+    step_global_ = plan_.force_split > 1 ? cl::NDRange((n_ + per - 1) / per * kSplitWorkGroup)
                                     : cl::NDRange((items + rounding - 1) / rounding * rounding);
-    step_local_ = force_split_ > 1 ? cl::NDRange(kSplitWorkGroup) : wg ? cl::NDRange(wg) : cl::NullRange;
+    step_local_ = plan_.force_split > 1 ? cl::NDRange(kSplitWorkGroup) : wg ? cl::NDRange(wg) : cl::NullRange;
   }
   const bool friction = std::any_of(scene.tori.begin(), scene.tori.end(), [](const TorusSpec& t) { return t.friction > 0; }) ||
                         std::any_of(scene.indenters.begin(), scene.indenters.end(),
@@ -246,19 +234,12 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   options += " -DVB_TRI_CONTACT=" + std::to_string(tri_contact_);
   // the penalty geometry in double where the device has it (kernels/triangle_contact.cl)
   options += " -DVB_TRI_FP64=" + std::to_string(tri_contact_ && cl_.info.fp64);
-  // device_contact.cl first: the indenters' friction reuses its grip helpers.
-  std::vector<std::string> sources = {"common.cl",         "hyperelastic.cl",     "device_contact.cl",
-                                      "lattice_forces.cl", "triangle_contact.cl", "integrate.cl",
-                                      "integrate_lanes.cl"};
-  if (volume_) sources.push_back("volume.cl");
-  sources.push_back("persistent.cl");
-  if (relax_) sources.push_back("relax.cl");
-  sources.push_back("checks.cl");
+  const std::vector<std::string> sources = plan_.kernel_files(volume_, relax_);
   program_ = build_program(cl, sources, lattice_tables_source(), options);
   kernel_files_ = sources;
   build_options_ = options;
   if (hyper_) {
-    // the stress of any u over every element (checks, host requests), and with stress_pair_ the
+    // the stress of any u over every element (checks, host requests), and with plan_.stress_pair the
     // step's launch of both stages over the stress list (kernels/hyperelastic.cl: v, dt, where the
     // predicted stage's Q and C go, the list), all of whose arguments are set once
     const auto stress_kernel = [&](cl_uint list_n) {
@@ -268,7 +249,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
       k.setArg(6, cl_uint(n_));
       k.setArg(7, at(rest_frame_));
       set_state_arena_arg(k);
-      if (stress_pair_) {
+      if (plan_.stress_pair) {
         k.setArg(8, at(v_));  // 9: dt (set_time_step_args)
         k.setArg(10, cl_uint2{{arena_at_pred_.s[5], arena_at_pred_.s[6]}});
         k.setArg(11, stress_list_at_);
@@ -277,20 +258,20 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
       return k;
     };
     stress_ = stress_kernel(0);
-    if (stress_pair_) step_stress_ = stress_kernel(cl_uint(stress_list_n_));
+    if (plan_.stress_pair) step_stress_ = stress_kernel(cl_uint(stress_list_n_));
   }
 
   const bool heun = scene.solver.integrator == Integrator::Heun;
   if (heun) {
-    predict_ = cl::Kernel(program_, lanes_ ? "heun_predict_lanes" : "heun_predict");
-    correct_ = cl::Kernel(program_, lanes_ ? "heun_correct_lanes" : "heun_correct");
+    predict_ = cl::Kernel(program_, plan_.lanes ? "heun_predict_lanes" : "heun_predict");
+    correct_ = cl::Kernel(program_, plan_.lanes ? "heun_correct_lanes" : "heun_correct");
   } else if (relax_) {
-    relax_kernel_ = cl::Kernel(program_, lanes_ ? "relax_step_lanes" : "relax_step");
+    relax_kernel_ = cl::Kernel(program_, plan_.lanes ? "relax_step_lanes" : "relax_step");
     relax_scale_ = make_real_buffer(relaxation_mass_scale(el, dt_.row_stiffness_n_m, penalty.row_n_m));
     dt_.row_stiffness_n_m = {};  // the host copy is not needed again
     relax_kernel_.setArg(kStepIndenter + kIndenterArgs + 2, relax_scale_);
   } else {
-    euler_ = cl::Kernel(program_, lanes_ ? "euler_step_lanes" : "euler_step");
+    euler_ = cl::Kernel(program_, plan_.lanes ? "euler_step_lanes" : "euler_step");
   }
   check_ = cl::Kernel(program_, "check_state");
   for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_}) {
@@ -299,9 +280,9 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
     k->setArg(kStepIndenter, at(indenters_));
     set_indenter_times(*k, kStepIndenter, 0.0, 0.0);
     set_state_arena_arg(*k);  // then dt (set_time_step_args)
-    k->setArg(kStepIndenter + kIndenterArgs + 1, cl_uint(step_list_ ? step_list_n_ : n_));  // VB_STEP_N
+    k->setArg(kStepIndenter + kIndenterArgs + 1, cl_uint(plan_.step_list ? step_list_n_ : n_));  // VB_STEP_N
   }
-  if (lanes_) make_lane_args();
+  if (plan_.lanes) make_lane_args();
   if (heun) {
     set_step_state_args(predict_, u_, v_, u_tmp_, v_tmp_);
     set_step_state_args(correct_, u_, v_, u_tmp_, v_tmp_);  // reads the stage from u_tmp_, v_tmp_
@@ -330,7 +311,7 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
   if (volume_) make_volume_buffers(surface_, surface_list, surface_index);
   if (!scene.tori.empty()) make_contact_area_buffer();
   if (tri_contact_) make_triangle_contact_buffers();
-  if (persistent_.on) make_persistent_kernel();
+  if (plan_.persistent.on) make_persistent_kernel();
   set_time_step_args();
   if (rest_offsets_) set_rest_offsets(std::vector<double>(3 * n_, 0.0));  // R₀ = I, J₀ = 1
 }
@@ -338,112 +319,12 @@ Simulator::Simulator(const Scene& scene, const Lattice& lattice, const ElementAr
 void Simulator::set_time_step_args() {
   for (cl::Kernel* k : {&euler_, &predict_, &correct_, &relax_kernel_})
     if ((*k)()) set_real(*k, kStepIndenter + kIndenterArgs, dt_.dt_s);
-  if (stress_pair_) {  // element_stress's predicted stage (kernels/hyperelastic.cl)
+  if (plan_.stress_pair) {  // element_stress's predicted stage (kernels/hyperelastic.cl)
     set_real(stress_, 9, dt_.dt_s);
     set_real(step_stress_, 9, dt_.dt_s);
   }
   if (check_dt_arg_ >= 0) set_real(check_, check_dt_arg_, dt_.dt_s);
-  if (persistent_.on) set_persistent_time_step();
-}
-
-// Heun's predicted stage packed (kernels/lattice_forces.cl, stage_load): ũ with ṽx in one real4,
-// ṽy, ṽz in a real2, so a warp's read of a neighbour's stage touches 6 cache lines instead of 8
-// (H200, linear cubes: heun_correct 10% shorter, the step 3-5% at 1.5M, 7% at 512k; docs/
-// PERFORMANCE.md, "Packed predicted stage"). Where the short loop takes at least half the free elements: the general
-// loop reads each neighbour's inverse mass from the state, a third line (the phantom at 50k-60k,
-// none on the short loop: 0 to 5% slower). Only where heun_correct alone reads the stage: no volume
-// constraint, indenters, tori or triangle contact, one work-item per element and no list (whose
-// held elements' stage is a copy of the state). VOXBREAST_PRED_PACKED=0|1 overrides the device
-// rule and the half, not the others.
-void Simulator::plan_pred_packing(const Scene& scene, const ElementArrays& el, const ClContext& cl) {
-  const bool allowed = scene.solver.integrator == Integrator::Heun && uniform_path_ && force_split_ == 1 &&
-                       !persistent_.on && !step_list_ && !lanes_ && !volume_ && scene.indenters.empty() &&
-                       scene.tori.empty() && !tri_contact_;
-  pred_packed_ = allowed && default_pred_packing(cl.info.is_gpu, uniform_elements_, n_ - el.held_count);
-  if (const char* env = std::getenv("VOXBREAST_PRED_PACKED")) pred_packed_ = allowed && std::atoi(env) != 0;
-}
-
-void Simulator::plan_launches(const Scene& scene, const ElementArrays& el, const ClContext& cl) {
-  const bool heun_steps = scene.solver.integrator == Integrator::Heun;
-  if (volume_) {
-    // A projection is two launches on GPUs (volume_partials, volume_apply) and one elsewhere
-    // (volume_project). On an H200 the one-launch form's last work-group, applying the projection
-    // alone, took 21.8 µs against 7.9 + 10.8 µs for the two launches (docs/PERFORMANCE.md); on PoCL
-    // the two cost the same. VOXBREAST_VOLUME_LAUNCHES=1|2 overrides, to compare them on a device.
-    // 0 (Heun only): no apply launch at all, the kernels that read the state next apply the
-    // pending projection (volume_pending; kernels/common.cl, VB_PENDING_PARAMS).
-    volume_launches_ = cl.info.is_gpu ? 2 : 1;
-    if (const char* env = std::getenv("VOXBREAST_VOLUME_LAUNCHES")) {
-      const int k = std::atoi(env);
-      if (k == 1 || k == 2) volume_launches_ = k;
-      // Triangle contact reads the state without a pending projection: it keeps the apply launches.
-      if (k == 0 && heun_steps && !tri_contact_) volume_launches_ = 0;
-    }
-  }
-  const bool folded = volume_ && volume_launches_ == 0;
-  // Heun's force passes on GPUs with each element's connections over 2 work-items for small
-  // hyperelastic models (kernels/integrate.cl, VB_SPLIT): ~1,100 warps at 36k elements leave a
-  // latency-bound pass short of threads. VOXBREAST_FORCE_SPLIT=1|2|4 overrides, on any device.
-  force_split_ = heun_steps && cl.info.is_gpu && el.hyperelastic && n_ <= kSplitMaxElements ? 2 : 1;
-  if (const char* env = std::getenv("VOXBREAST_FORCE_SPLIT")) {
-    const int k = std::atoi(env);
-    if (heun_steps && (k == 1 || k == 2 || k == 4)) force_split_ = k;
-  }
-  // Every integrator on CPUs for plain float spring models: the kernels that step 8 elements per
-  // work-item in float8 vectors (kernels/integrate_lanes.cl, relax.cl); VOXBREAST_LANES=0 keeps the
-  // real4 kernels, to compare.
-  lanes_ = !cl.info.is_gpu && precision_ == Precision::Float && !el.hyperelastic && !el.biphasic &&
-           scene.indenters.empty() && scene.tori.empty() && !tri_contact_ && !folded && !rest_offsets_ &&
-           force_split_ == 1;
-  if (const char* env = std::getenv("VOXBREAST_LANES")) lanes_ = lanes_ && std::atoi(env) != 0;
-  // Heun's whole step in one launch where the device allows it (kernels/persistent.cl): not with
-  // triangle contact (its own pass) or folded projections (another way to fewer launches).
-  persistent_ = plan_persistent_step(cl.info, heun_steps && !tri_contact_ && !folded, el.hyperelastic, n_,
-                                     force_split_, kPersistentMaxElements);
-  // The stepping kernels over a list of the free elements (kernels/common.cl, VB_STEP_LIST), on
-  // GPUs for large models with a quarter or more held (step_list_rule.hpp): those then cost no
-  // work-item and no copy of their state per step (the phantom, two thirds held: Heun +10% at
-  // 76k, +16% at 1.5M, up to +38% between; relaxation and Euler +2% to +41%). Not with the lanes
-  // kernels (their own list), the split force pass or the one-launch step (their own layouts).
-  // VOXBREAST_STEP_LIST=0|1 overrides the device rule, not the others.
-  const bool list_allowed = !lanes_ && force_split_ == 1 && !persistent_.on;
-  step_list_ = list_allowed && default_step_list(cl.info.is_gpu, n_, el.held_count, relax_ && el.hyperelastic);
-  if (const char* env = std::getenv("VOXBREAST_STEP_LIST")) step_list_ = list_allowed && std::atoi(env) != 0;
-  // Heun's corrector over the elements' blocks from the last to the first (kernels/integrate.cl,
-  // VB_CORRECT_REVERSE; correct_order.hpp): it starts where the predictor ended (H200: linear
-  // cubes of 1.0M and 1.5M elements 4-5% faster). One work-item per element in the elements'
-  // order: not with the list, the split pass, the lanes kernels or the one-launch step.
-  // VOXBREAST_CORRECT_REVERSE=0|1 overrides the device rule (size, volume), not the others.
-  const bool reverse_allowed = heun_steps && !lanes_ && force_split_ == 1 && !persistent_.on && !step_list_;
-  correct_reverse_ = reverse_allowed && default_correct_reverse(cl.info.is_gpu, n_, volume_);
-  if (const char* env = std::getenv("VOXBREAST_CORRECT_REVERSE")) correct_reverse_ = reverse_allowed && std::atoi(env) != 0;
-  // Linear springs on GPUs: elements whose neighbours share their E and mass take a short
-  // connection loop (kernels/lattice_forces.cl, lattice_force_uniform; docs/PERFORMANCE.md),
-  // marked by a negative E in whole warps (uniform_neighbourhood.hpp). Not in the one-launch step,
-  // whose register cap the second loop overflows (36k cube 72.9k → 47.9k steps/s on the H200), nor
-  // with the lanes kernels (skipping the neighbour's E saves little on a CPU). Off
-  // by default with the step list (the H200 ran both together 11% slower than the short loop alone
-  // on the 1.5M cube, and 4% slower than the list alone on the phantom). VOXBREAST_UNIFORM_PATH=0|1
-  // overrides the device rule, not the others.
-  const bool uniform_allowed = !el.hyperelastic && !el.biphasic && !rest_offsets_ && !lanes_ && !persistent_.on;
-  uniform_path_ = uniform_allowed && cl.info.is_gpu && !step_list_;
-  if (const char* env = std::getenv("VOXBREAST_UNIFORM_PATH")) uniform_path_ = uniform_allowed && std::atoi(env) != 0;
-  // Heun's predicted stage under the last correction's pressure instead of a projection of its
-  // own (docs/PHYSICS.md, "Volume preservation"): one launch fewer per step on CPUs, two on GPUs.
-  // Projected as before when the scene asks, between corrections (every > 1: no multiplier to
-  // lag), with folded projections, and in the one-launch step (kernels/persistent.cl keeps its
-  // own schedule).
-  // Relaxation's step feels the lagged pressure too (kernels/relax.cl: why).
-  const bool lag_heun = heun_steps && scene.volume.predictor == VolumeSpec::Predictor::Pressure;
-  volume_lag_ = volume_ && (lag_heun || relax_) && scene.volume.every == 1 && !folded && !persistent_.on;
-  // Both of Heun's element stresses in one launch (kernels/hyperelastic.cl, VB_STRESS_PAIR): the
-  // predicted stage moves each free element to ũ = u + dt·v whatever its force, so the stress at ũ
-  // needs only (u, v). Not where something else moves ũ: indenters and tori project it out of
-  // themselves, the predicted stage's own volume projection; nor with folded projections or the
-  // one-launch step (their own passes). VOXBREAST_STRESS_PAIR=0 keeps two launches, to compare.
-  stress_pair_ = hyper_ && heun_steps && scene.indenters.empty() && scene.tori.empty() && (!volume_ || volume_lag_) &&
-                 !folded && !persistent_.on;
-  if (const char* env = std::getenv("VOXBREAST_STRESS_PAIR")) stress_pair_ = stress_pair_ && std::atoi(env) != 0;
+  if (plan_.persistent.on) set_persistent_time_step();
 }
 
 void Simulator::make_lane_args() {
@@ -515,7 +396,7 @@ void Simulator::make_state_arena(std::size_t state_bytes, std::size_t frame_byte
     const std::size_t grad = 4 * real_size_ * n_, scalars = kVolumeScalars * real_size_;
     parts.insert(parts.end(),
                  {{&vol_grad_, grad}, {&vol_partial_, volume_groups_ * kVolumeSlots * real_size_}, {&vol_scalars_, scalars}});
-    if (volume_launches_ == 0)  // the predicted stage's pending projection, and no projection
+    if (plan_.volume_launches == 0)  // the predicted stage's pending projection, and no projection
       parts.insert(parts.end(), {{&vol_grad_pred_, grad}, {&vol_scalars_pred_, scalars}, {&vol_no_scalars_, scalars}});
   }
   for (const auto& [buffer, bytes] : parts) state_.add(buffer == &indenters_ ? table.data() : nullptr, bytes);
@@ -550,28 +431,28 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
       arena_.add(nullptr, 3 * row_bytes),
       arena_.add(nullptr, row_bytes),
       arena_.add(nullptr, offset_bytes)};  // rest offsets: zero until set_rest_offsets
-  // The predicted stage's Q and C (stress_pair_): what heun_correct reads in place of slots 5 and 6.
-  const std::size_t pred_q = stress_pair_ ? arena_.add(nullptr, 3 * row_bytes) : 0;
-  const std::size_t pred_c = stress_pair_ ? arena_.add(nullptr, row_bytes) : 0;
+  // The predicted stage's Q and C (plan_.stress_pair): what heun_correct reads in place of slots 5 and 6.
+  const std::size_t pred_q = plan_.stress_pair ? arena_.add(nullptr, 3 * row_bytes) : 0;
+  const std::size_t pred_c = plan_.stress_pair ? arena_.add(nullptr, row_bytes) : 0;
   // The step's stress pass skips held elements that no free element reads (stress_list_n_).
-  const std::vector<cl_uint> list = stress_pair_ ? elements_read_by_free(lattice_, inverse_mass_) : std::vector<cl_uint>{};
+  const std::vector<cl_uint> list = plan_.stress_pair ? elements_read_by_free(lattice_, inverse_mass_) : std::vector<cl_uint>{};
   stress_list_n_ = list.size() < n_ ? list.size() : 0;
   const std::size_t list_slot = stress_list_n_ ? arena_.add(list.data(), list.size() * sizeof(cl_uint)) : 0;
   device_bytes_ += stress_list_n_ * sizeof(cl_uint);
-  const std::vector<cl_uint> step_list = step_list_ ? free_elements(inverse_mass_) : std::vector<cl_uint>{};
+  const std::vector<cl_uint> step_list = plan_.step_list ? free_elements(inverse_mass_) : std::vector<cl_uint>{};
   step_list_n_ = step_list.size();
-  const std::size_t step_list_slot = step_list_ ? arena_.add(step_list.data(), std::max<std::size_t>(1, step_list_n_) * sizeof(cl_uint)) : 0;
+  const std::size_t step_list_slot = plan_.step_list ? arena_.add(step_list.data(), std::max<std::size_t>(1, step_list_n_) * sizeof(cl_uint)) : 0;
   device_bytes_ += step_list_n_ * sizeof(cl_uint);
   require_buffer_fits("the model's arrays", arena_.bytes(), cl_.info);
   arena_.create(cl_);
   for (int i = 0; i < 8; ++i) arena_at_.s[i] = arena_.offset_units(slot[i]);
   arena_at_pred_ = arena_at_;
-  if (stress_pair_) {
+  if (plan_.stress_pair) {
     arena_at_pred_.s[5] = arena_.offset_units(pred_q);
     arena_at_pred_.s[6] = arena_.offset_units(pred_c);
   }
   stress_list_at_ = stress_list_n_ ? arena_.offset_units(list_slot) : 0;
-  step_list_at_ = step_list_ ? arena_.offset_units(step_list_slot) : 0;
+  step_list_at_ = plan_.step_list ? arena_.offset_units(step_list_slot) : 0;
   E_ = arena_.part(slot[0]);
   cell_ = arena_.part(slot[1]);
   materials_ = arena_.part(slot[4]);
@@ -580,7 +461,7 @@ void Simulator::make_model_arena(const ElementArrays& el, const std::vector<cl_i
 
 std::vector<double> Simulator::device_modulus(const std::vector<double>& youngs_modulus_pa) {
   std::vector<double> marked =
-      uniform_path_ ? mark_uniform_neighbourhoods(lattice_, youngs_modulus_pa, inverse_mass_, cl_.info.simd_width)
+      plan_.uniform_path ? mark_uniform_neighbourhoods(lattice_, youngs_modulus_pa, inverse_mass_, cl_.info.simd_width)
                     : youngs_modulus_pa;
   uniform_elements_ = std::size_t(std::count_if(marked.begin(), marked.end(), [](double E) { return E < 0; }));
   return marked;
@@ -710,7 +591,7 @@ void Simulator::enqueue(cl::Kernel& k) const { launch(k, global_, local_); }
 void Simulator::enqueue_stress(const cl::Buffer& u, const cl::Buffer* pending_grad, const cl::Buffer* pending_scalars) {
   if (!hyper_) return;
   stress_.setArg(0, at(u));
-  if (volume_launches_ == 0) {  // element_stress's pending projection (VB_VOLUME_FOLD)
+  if (plan_.volume_launches == 0) {  // element_stress's pending projection (VB_VOLUME_FOLD)
     stress_.setArg(8, at(pending_grad ? *pending_grad : vol_grad_));
     stress_.setArg(9, at(pending_scalars ? *pending_scalars : vol_no_scalars_));
   }
@@ -741,7 +622,7 @@ void Simulator::advance(std::int64_t steps) {
     if (has_paths) follow_paths(t0);
     if (scene_.solver.integrator == Integrator::Heun) {
       const bool project = volume_ && (steps_ + 1) % scene_.volume.every == 0;
-      if (persistent_.on) {  // the whole step, its projections included
+      if (plan_.persistent.on) {  // the whole step, its projections included
         enqueue_persistent_step(t0, t1, indenter, project);
         continue;
       }
@@ -749,7 +630,7 @@ void Simulator::advance(std::int64_t steps) {
         set_indenter_times(predict_, kStepIndenter, t0, t1);
         set_indenter_times(correct_, kStepIndenter, t1, t1);
       }
-      if (volume_launches_ == 0) {
+      if (plan_.volume_launches == 0) {
         // Projections left pending (kernels/volume.cl, volume_pending): the readers of each
         // projected state apply it, and only the state's own gradient and scalars stay pending
         // after the step.
@@ -763,14 +644,14 @@ void Simulator::advance(std::int64_t steps) {
         pending_ = project;
         continue;
       }
-      if (stress_pair_) enqueue_stress_pair(); else enqueue_stress(u_);
+      if (plan_.stress_pair) enqueue_stress_pair(); else enqueue_stress(u_);
       enqueue_triangle_contact(u_, t0);
       launch(predict_, step_global_, step_local_);
       // The predicted stage meets the constraint too, by the lagged pressure (in heun_predict) or
       // its own projection: its velocity along g would otherwise reach the corrector's dashpots
       // and leave a steady slip at the constrained equilibrium.
-      if (project && !volume_lag_) enqueue_volume_correction(u_tmp_, v_tmp_);
-      if (!stress_pair_) enqueue_stress(u_tmp_);
+      if (project && !plan_.volume_lag) enqueue_volume_correction(u_tmp_, v_tmp_);
+      if (!plan_.stress_pair) enqueue_stress(u_tmp_);
       enqueue_triangle_contact(u_tmp_, t1);
       launch(correct_, step_global_, step_local_);
     } else {
@@ -869,7 +750,7 @@ void Simulator::set_gravity(const Vec3& g) {
   if (volume_) {
     set_world_vector(vol_partials_, 2 + kLatticeGravity, g);
     set_world_vector(vol_project_, 2 + kLatticeGravity, g);
-    if (volume_launches_ == 0) set_world_vector(vol_pending_, 2 + kLatticeGravity, g);
+    if (plan_.volume_launches == 0) set_world_vector(vol_pending_, 2 + kLatticeGravity, g);
   }
 }
 

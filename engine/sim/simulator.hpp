@@ -15,7 +15,7 @@
 #include "engine/sim/device_arena.hpp"
 #include "engine/sim/element_setup.hpp"
 #include "engine/sim/opencl_runtime.hpp"
-#include "engine/sim/persistent_step.hpp"
+#include "engine/sim/launch_plan.hpp"
 #include "engine/sim/time_step.hpp"
 #include "engine/surface/surface_mesh.hpp"
 
@@ -80,7 +80,13 @@ class Simulator {
   /// Uploads the model. Throws vb::Error for double precision on a device without fp64, a model
   /// too large for the device's memory, or more indenters and tori than the check kernel's local
   /// memory holds.
-  Simulator(const Scene& scene, const Lattice& lattice, const ElementArrays& elements, const ClContext& cl);
+  /// `overrides` force launch-plan choices where the plan allows them (launch_plan.hpp: to compare
+  /// plans on a device, and to run another device's plan in tests); the physics is the same.
+  Simulator(const Scene& scene, const Lattice& lattice, const ElementArrays& elements, const ClContext& cl,
+            const PlanOverrides& overrides = {});
+
+  /// The launch schedule this simulator took (launch_plan.hpp).
+  const LaunchPlan& launch_plan() const { return plan_; }
 
   /// Enqueues `steps` time steps; returns without waiting for the device.
   void advance(std::int64_t steps);
@@ -159,23 +165,23 @@ class Simulator {
   /// kernels/triangle_contact.cl computes them; for tests.
   std::vector<double> triangle_contact_forces_n();
   /// kernel launches per projection of the volume constraint: 1 (volume_project) or 2
-  /// (volume_partials, volume_apply; VOXBREAST_VOLUME_LAUNCHES=2), or 0 (Heun only,
-  /// VOXBREAST_VOLUME_LAUNCHES=0): volume_pending computes the projection and the kernels that read
-  /// the state next apply it, with no apply launch (kernels/volume.cl)
-  int volume_launches() const { return volume_launches_; }
+  /// (volume_partials, volume_apply), or 0 (folded, Heun only): volume_pending computes the
+  /// projection and the kernels that read the state next apply it, with no apply launch
+  /// (kernels/volume.cl). The accessors below read the launch plan (launch_plan.hpp).
+  int volume_launches() const { return plan_.volume_launches; }
   /// Whether Heun's predicted stage feels the lagged constraint pressure instead of being projected.
-  bool volume_predictor_pressure() const { return volume_lag_ && !relax_; }
+  bool volume_predictor_pressure() const { return plan_.volume_lag && !relax_; }
   /// Whether elements with a uniform neighbourhood take the short connection loop (linear springs),
   /// and how many do (engine/sim/uniform_neighbourhood.hpp).
-  bool uniform_path() const { return uniform_path_; }
+  bool uniform_path() const { return plan_.uniform_path; }
   std::size_t uniform_elements() const { return uniform_elements_; }
   /// Whether Heun's predicted stage is stored packed (ũ, ṽx | ṽy, ṽz; kernels/lattice_forces.cl).
-  bool pred_packed() const { return pred_packed_; }
+  bool pred_packed() const { return plan_.pred_packed; }
   /// Whether Heun's corrector steps the elements' blocks from the last to the first
   /// (engine/sim/correct_order.hpp).
-  bool correct_reverse() const { return correct_reverse_; }
+  bool correct_reverse() const { return plan_.correct_reverse; }
   /// Whether the stepping kernels run over a list of the free elements (GPUs; kernels/integrate.cl).
-  bool step_list() const { return step_list_; }
+  bool step_list() const { return plan_.step_list; }
   /// Work-items per group of the stepping kernels (step_work_group.hpp); 0: the device picks (PoCL).
   std::size_t step_work_group() const { return step_local_.dimensions() ? step_local_[0] : 0; }
   /// The volume constraint's scalars as the last kernel left them (kernels/volume.cl; lattice
@@ -187,16 +193,15 @@ class Simulator {
   };
   VolumeScalars volume_scalars() const;
   /// work-items per element in Heun's force passes (kernels/integrate.cl, VB_SPLIT): 2 on GPUs for
-  /// hyperelastic models up to 98,304 elements, else 1; VOXBREAST_FORCE_SPLIT=1|2|4 overrides
-  int force_split() const { return force_split_; }
+  /// hyperelastic models up to kSplitMaxElements, else 1
+  int force_split() const { return plan_.force_split; }
   /// every integrator steps with the CPU kernels that take 8 free elements per work-item in float8
-  /// vectors (kernels/integrate_lanes.cl): CPU devices, plain float spring models; VOXBREAST_LANES=0
-  /// turns them off
-  bool lanes() const { return lanes_; }
+  /// vectors (kernels/integrate_lanes.cl): CPU devices, plain float spring models
+  bool lanes() const { return plan_.lanes; }
   /// Heun's whole step runs as one launch (kernels/persistent.cl; NVIDIA GPUs, small models)
-  bool persistent_step() const { return persistent_.on; }
+  bool persistent_step() const { return plan_.persistent.on; }
   /// Heun's two element stresses computed in one launch (kernels/hyperelastic.cl, VB_STRESS_PAIR)
-  bool stress_pair() const { return stress_pair_; }
+  bool stress_pair() const { return plan_.stress_pair; }
   /// The elements whose stresses that launch computes: those some free element reads (a held
   /// element deep in the held region is left out), or every element.
   std::size_t stress_pass_elements() const { return stress_list_n_ ? stress_list_n_ : n_; }
@@ -237,17 +242,12 @@ class Simulator {
   void enqueue(cl::Kernel& k) const;
   void enqueue_check() const;
   void adapt_relaxation_damping(const std::vector<double>& partial);
-  /// element stress of u; with VOXBREAST_VOLUME_LAUNCHES=0, with u's pending projection (gradient,
+  /// element stress of u; with folded projections (plan_.volume_launches == 0), with u's pending projection (gradient,
   /// scalars; none when null)
   void enqueue_stress(const cl::Buffer& u, const cl::Buffer* pending_grad = nullptr,
                       const cl::Buffer* pending_scalars = nullptr);
-  /// element stresses of (u_, v_) and of Heun's predicted stage u_ + dt·v_ in one launch (stress_pair_)
+  /// element stresses of (u_, v_) and of Heun's predicted stage u_ + dt·v_ in one launch (plan_.stress_pair)
   void enqueue_stress_pair();
-  /// Decides the launch schedule (volume launches, force split, lanes, one-launch step, lagged
-  /// pressure, paired stress) before anything is allocated: the arena depends on it.
-  void plan_launches(const Scene& scene, const ElementArrays& el, const ClContext& cl);
-  /// Whether Heun's predicted stage is stored packed (pred_packed_): after the short loop's marks.
-  void plan_pred_packing(const Scene& scene, const ElementArrays& el, const ClContext& cl);
   void make_model_arena(const ElementArrays& el, const std::vector<cl_int>& grid, const std::vector<cl_uint>& cell_of,
                         std::size_t offset_bytes);
   std::vector<unsigned char> real_bytes(const std::vector<double>& values) const;  ///< in the model's precision
@@ -263,6 +263,7 @@ class Simulator {
   const Scene& scene_;
   const Lattice& lattice_;
   const ClContext& cl_;
+  LaunchPlan plan_;  ///< chosen once in the constructor (choose_launch_plan)
   Precision precision_;
   std::size_t n_;
   TimeStepChoice dt_;
@@ -291,8 +292,8 @@ class Simulator {
   /// VB_UNPACK_LATTICE) and their offsets; E_, cell_, materials_, rest_offset_ are the host's views of four.
   DeviceArena arena_;
   cl_uint8 arena_at_{};
-  cl_uint8 arena_at_pred_{};  ///< arena_at_ with the predicted stage's Q and C (stress_pair_), for heun_correct
-  /// stress_pair_: the elements the step's stress pass covers (elements_read_by_free, in the arena
+  cl_uint8 arena_at_pred_{};  ///< arena_at_ with the predicted stage's Q and C (plan_.stress_pair), for heun_correct
+  /// plan_.stress_pair: the elements the step's stress pass covers (elements_read_by_free, in the arena
   /// at stress_list_at_), 0 when that is every element
   std::size_t stress_list_n_ = 0;
   cl_uint stress_list_at_ = 0;
@@ -307,7 +308,7 @@ class Simulator {
   std::vector<double> contact_area_host_;
   int check_slots_ = 0;  ///< hyperelastic: tissue ids, law table, Q and F rows
   cl::Kernel stress_;
-  cl::Kernel step_stress_;  ///< stress_pair_: element_stress with the step's arguments (enqueue_stress_pair)
+  cl::Kernel step_stress_;  ///< plan_.stress_pair: element_stress with the step's arguments (enqueue_stress_pair)
   cl::Program program_;
   std::vector<std::string> kernel_files_;
   std::string build_options_;
@@ -347,23 +348,19 @@ class Simulator {
   double read_enclosed_volume_m3() const;
   /// the rest volume (lattice frame) into the kernels that compute λ
   void set_rest_volume_args();
-  // VOXBREAST_VOLUME_LAUNCHES=0 (volume_launches_ == 0): projections left pending
+  // folded projections (plan_.volume_launches == 0): projections left pending
   /// the stepping kernels' pending projections: of (u, v) and of the predicted stage
   void set_fold_args(bool state_pending, bool pred_pending);
   /// volume_pending on (u, v): the gradient and scalars of the state's or the predicted stage's
   void enqueue_pending_projection(const cl::Buffer& u, const cl::Buffer& v, bool predicted);
   /// applies the state's pending projection (volume_apply) before anything else reads u, v
   void apply_pending_projection() const;
-  bool volume_pairs_ = true;  ///< incident triangles as element pairs (VB_VOLUME_PAIRS)
   mutable bool pending_ = false;  ///< (u_, v_) has a projection pending (vol_grad_, vol_scalars_)
-  int force_split_ = 1;
-  bool lanes_ = false;  ///< the stepping kernels of kernels/integrate_lanes.cl (VB_LANES)
   /// the lanes kernels' arguments: the free elements' list (free_list_, padded to kLaneWidth), their count
   void make_lane_args();
   /// copies (u, v) into the scratch pair (u_tmp_, v_tmp_): the lanes kernels and the listed step
-  /// (step_list_) never write held elements, so both pairs must hold them (upload, make_lane_args)
+  /// (plan_.step_list) never write held elements, so both pairs must hold them (upload, make_lane_args)
   void mirror_state();
-  bool step_list_ = false;           ///< the stepping kernels over the free elements' list (VB_STEP_LIST)
   std::size_t step_list_n_ = 0;      ///< free elements in it
   cl_uint step_list_at_ = 0;         ///< its offset in the model arena (units; compiled in)
   cl::Buffer free_list_;
@@ -376,13 +373,7 @@ class Simulator {
   double rest_volume_m3_ = 0, frame_sign_ = 1;  ///< det(rotation): lattice-frame V = sign·V_world
   std::size_t volume_surface_ = 0, volume_groups_ = 0;
   std::size_t volume_wg_ = 0;   ///< work-group size of volume_project (VB_VOLUME_WG)
-  int volume_launches_ = 1;     ///< per projection: 1 volume_project, 2 volume_partials + volume_apply, 0 folded
-  bool stress_pair_ = false;  ///< Heun's two element stresses in one launch (VB_STRESS_PAIR)
-  bool volume_lag_ = false;  ///< Heun's predicted stage (relaxation's step) under the lagged pressure
-  bool uniform_path_ = false;  ///< linear springs: uniform neighbourhoods marked, their short loop compiled in
   std::size_t uniform_elements_ = 0;  ///< elements marked
-  bool pred_packed_ = false;  ///< Heun's predicted stage packed (VB_PRED_PACKED)
-  bool correct_reverse_ = false;  ///< heun_correct over the blocks last to first (VB_CORRECT_REVERSE)
   DeviceArena vol_mesh_;  ///< triangles, surface elements, incident start, incident (kernels/volume.cl)
   cl_uint4 vol_mesh_at_{};
   cl::Buffer vol_grad_, vol_partial_,
@@ -399,7 +390,6 @@ class Simulator {
   /// throws vb::Error when a grid barrier timed out (work-groups not all resident); check() and
   /// download() call it
   void check_grid_barriers() const;
-  PersistentPlan persistent_;
   cl::Kernel persistent_kernel_;
   cl::Buffer grid_sync_;       ///< barrier count, fault flag
   cl_uint sync_start_ = 0;     ///< the count when the next launch starts

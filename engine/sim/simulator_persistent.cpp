@@ -26,7 +26,7 @@ void Simulator::make_persistent_kernel() {
   cl::Kernel& k = persistent_kernel_ = cl::Kernel(program_, "heun_step_persistent");
   // Every group must be resident at once: the build log says how many registers the kernel
   // really uses (docs/PERFORMANCE.md, "GPU-only guards").
-  persistent_.fit_registers(
+  plan_.persistent.fit_registers(
       registers_in_build_log(program_.getBuildInfo<CL_PROGRAM_BUILD_LOG>(cl_.info.device), "heun_step_persistent"),
       cl_.info.compute_units);
   k.setArg(0, u_);
@@ -65,31 +65,31 @@ void Simulator::enqueue_persistent_step(double t0_s, double t1_s, bool moving_ob
   }
   if (volume_) k.setArg(kProject, cl_int(project));
   k.setArg(sync_arg(volume_) + 1, sync_start_);
-  launch(k, cl::NDRange(persistent_.groups * PersistentPlan::kWorkGroup), cl::NDRange(PersistentPlan::kWorkGroup));
+  launch(k, cl::NDRange(plan_.persistent.groups * PersistentPlan::kWorkGroup), cl::NDRange(PersistentPlan::kWorkGroup));
   // the kernel's grid barriers: 2 around the stress passes, 1 after the predictor, 4 per projection
   const cl_uint barriers = cl_uint(1 + (hyper_ ? 2 : 0) + (project ? 4 : 0));
-  sync_start_ += barriers * cl_uint(persistent_.groups);  // wraps as the kernel's count does
+  sync_start_ += barriers * cl_uint(plan_.persistent.groups);  // wraps as the kernel's count does
 }
 
 void Simulator::check_grid_barriers() const {
-  if (!persistent_.on) return;
+  if (!plan_.persistent.on) return;
   cl_uint sync[kSyncWords] = {};
   cl_.queue.enqueueReadBuffer(grid_sync_, CL_TRUE, 0, sizeof sync, sync);
-  if (persistent_.trace) {  // ns between group 0's stamps of the last launch: pass by pass
-    std::cerr << "persistent step, " << persistent_.groups << " groups, last launch's passes (us):";
+  if (plan_.persistent.trace) {  // ns between group 0's stamps of the last launch: pass by pass
+    std::cerr << "persistent step, " << plan_.persistent.groups << " groups, last launch's passes (us):";
     for (int k = 3; k < kSyncWords && sync[k] != 0; ++k) std::cerr << ' ' << 1e-3 * double(sync[k] - sync[k - 1]);
     std::cerr << '\n';
   }
   require(sync[1] == 0,
           "the persistent Heun step's work-groups were not all resident on the device (a grid barrier timed out), "
           "so the state is not valid",
-          "device", "set VOXBREAST_PERSISTENT=0 to step with one launch per pass");
+          "device", "the one-launch step does not fit this device: report it with the output of `voxbreast info`");
   // Each launch's targets start from the count the host predicts (enqueue_persistent_step): a
   // barrier count the host and the kernel disagree on would let groups pass barriers early.
   require(sync[0] == sync_start_,
           "the persistent Heun step's barrier count (" + std::to_string(sync[0]) + ") is not the expected " +
               std::to_string(sync_start_) + ", so its passes may have overlapped and the state is not valid",
-          "device", "set VOXBREAST_PERSISTENT=0 to step with one launch per pass");
+          "device", "the one-launch step does not fit this device: report it with the output of `voxbreast info`");
 }
 
 }  // namespace vb

@@ -88,7 +88,7 @@ void Simulator::upload(const std::vector<double>& u, const std::vector<double>& 
   pending_ = false;  // the new state replaces the one the projection was for
   // nor is the lagged multiplier that of the new state: start it at zero (all-zero bytes; the
   // constructor's upload comes before the buffer, which starts at zero)
-  if (volume_lag_ && vol_scalars_())
+  if (plan_.volume_lag && vol_scalars_())
     cl_.queue.enqueueFillBuffer(vol_scalars_, cl_uchar(0), std::size_t(kVolumeScalars - 1) * real_size_, real_size_);
   if (precision_ == Precision::Double) {
     write_xyz<double>(u_, u, &inverse_mass_);
@@ -97,7 +97,7 @@ void Simulator::upload(const std::vector<double>& u, const std::vector<double>& 
     write_xyz<float>(u_, u, &inverse_mass_);
     write_xyz<float>(v_, v, nullptr);
   }
-  if (lanes_ || step_list_) mirror_state();
+  if (plan_.lanes || plan_.step_list) mirror_state();
   if (relax_) {
     held_u_.clear();
     for (std::size_t e = 0; e < n_; ++e)

@@ -26,7 +26,7 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh, const std::vector<c
   incident.resize(start.back());
   std::vector<cl_uint> fill(start.begin(), start.end() - 1);
   for (std::size_t k = 0; k < triangles.size(); ++k) incident[fill[surface_index[triangles[k]]]++] = cl_uint(k);
-  if (volume_pairs_) {  // per incident corner the triangle's other two corners' elements, in cyclic order
+  if (plan_.volume_pairs) {  // per incident corner the triangle's other two corners' elements, in cyclic order
     std::vector<cl_uint> pairs(2 * incident.size());
     for (std::size_t k = 0; k < incident.size(); ++k) {
       const std::size_t t = incident[k] / 3, corner = incident[k] % 3;
@@ -87,7 +87,7 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh, const std::vector<c
   vol_project_.setArg(kProjectGrad + 1, vol_partial_);
   vol_project_.setArg(kProjectRestVolume + 1, vol_scalars_);
   vol_project_.setArg(kProjectRestVolume + 2, vol_done_);
-  if (volume_launches_ == 0) {
+  if (plan_.volume_launches == 0) {
     // the predicted stage's projection has its own gradient and scalars: the state's stays
     // pending for heun_correct's own u, v while the stage's is computed
     // (its gradient and scalars, and zero scalars, are in the state arena)
@@ -97,7 +97,7 @@ void Simulator::make_volume_buffers(const SurfaceMesh& mesh, const std::vector<c
     vol_pending_.setArg(kProjectRestVolume + 2, vol_done_);
     set_fold_args(false, false);
   }
-  if (volume_lag_) {  // heun_predict's or relax_step's (and lanes') last arguments before VB_TRI_PARAMS, the arena
+  if (plan_.volume_lag) {  // heun_predict's or relax_step's (and lanes') last arguments before VB_TRI_PARAMS, the arena
     cl::Kernel& k = relax_ ? relax_kernel_ : predict_;
     const int last = int(k.getInfo<CL_KERNEL_NUM_ARGS>()) - (tri_contact_ ? kTriangleArgs : 0) - 1;
     k.setArg(last - 2, at(vol_grad_));
@@ -119,7 +119,7 @@ void Simulator::set_rest_volume_args() {
   set_real(vol_finish_, 2, v0);
   set_real(vol_apply_, kApplyRestVolume, v0);
   set_real(vol_project_, kProjectRestVolume, v0);
-  if (volume_launches_ == 0) set_real(vol_pending_, kProjectRestVolume, v0);
+  if (plan_.volume_launches == 0) set_real(vol_pending_, kProjectRestVolume, v0);
   if (persistent_kernel_()) set_persistent_rest_volume(v0);
 }
 
@@ -171,7 +171,7 @@ void Simulator::enqueue_volume_sums(bool with_force, const cl::Buffer& u, const 
 }
 
 void Simulator::enqueue_volume_correction(const cl::Buffer& u, const cl::Buffer& v) {
-  if (volume_launches_ == 1) {  // sums, λ and μ, and the projection in one launch
+  if (plan_.volume_launches == 1) {  // sums, λ and μ, and the projection in one launch
     vol_project_.setArg(0, u);
     vol_project_.setArg(1, v);
     const std::size_t groups = (volume_surface_ + volume_wg_ - 1) / volume_wg_;

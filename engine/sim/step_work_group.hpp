@@ -21,9 +21,9 @@ constexpr std::size_t default_step_work_group(std::size_t elements) {
   return elements >= kStepWorkGroupLargeFrom ? kStepWorkGroupLarge : kStepWorkGroup;
 }
 
-/// The group size VOXBREAST_STEP_WG asks for (to compare sizes on a device), checked: a multiple of
-/// 32 (the marks of the short connection loop are whole warps) within what the device allows.
-/// Throws vb::Error naming the problem otherwise.
-std::size_t step_work_group_override(const char* text, std::size_t device_max);
+/// A group size asked for (PlanOverrides::step_work_group, to compare sizes on a device), checked: a
+/// multiple of 32 (the marks of the short connection loop are whole warps) within what the device
+/// allows. Throws vb::Error naming the problem otherwise.
+std::size_t checked_step_work_group(std::size_t size, std::size_t device_max);
 
 }  // namespace vb

@@ -65,8 +65,8 @@ grep -q -- "--dashpot-ratio" "$work/bad_zeta.txt" || { cat "$work/bad_zeta.txt";
 # --dashpot-ratio 0 (global damping only) must reach the row and its floor (which then reads no
 # neighbour velocity).
 for zeta in 0.1 0; do
-  VOXBREAST_LANES=0 VOXBREAST_UNIFORM_PATH=1 VOXBREAST_PRED_PACKED=1 \
-    "$bin" bench --quick --no-study --sizes 10 --laws linear --dashpot-ratio $zeta --out "$work/floor_$zeta" >/dev/null
+  "$bin" bench --quick --no-study --sizes 10 --laws linear --dashpot-ratio $zeta \
+    --plan lanes=0,uniform_path=1,pred_packed=1 --out "$work/floor_$zeta" >/dev/null
 done
 /usr/bin/python3 - "$work/floor_lanes/throughput.csv" "$work/floor_0.1/throughput.csv" "$work/floor_0/throughput.csv" <<'PY'
 import csv, math, sys

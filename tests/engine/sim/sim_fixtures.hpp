@@ -14,27 +14,15 @@
 
 namespace vb::test {
 
-/// Sets an environment variable (the simulator's VOXBREAST_* switches) for its lifetime, so that a
-/// failed assertion or an exception does not leave it set for the next test.
-struct ScopedEnv {
-  ScopedEnv(const char* name, const std::string& value) : name_(name) { setenv(name, value.c_str(), 1); }
-  ~ScopedEnv() { unsetenv(name_); }
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-
- private:
-  const char* name_;
-};
-
-/// For its lifetime, the stepping kernels of a new simulator are the real4 kernels with one
-/// work-item per element (or listed element), in the elements' order: not the CPU lanes kernels,
-/// the one-launch step (GPUs) or the split force pass (GPUs, hyperelastic), each of which keeps its
-/// own range, order and list.
-struct OneItemPerElement {
-  ScopedEnv lanes{"VOXBREAST_LANES", "0"};
-  ScopedEnv one_launch{"VOXBREAST_PERSISTENT", "0"};
-  ScopedEnv split{"VOXBREAST_FORCE_SPLIT", "1"};
-};
+/// `o` with the stepping kernels made the real4 kernels with one work-item per element (or listed
+/// element), in the elements' order: not the CPU lanes kernels, the one-launch step (GPUs) or the
+/// split force pass (GPUs, hyperelastic), each of which keeps its own range, order and list.
+inline PlanOverrides one_item_per_element(PlanOverrides o = {}) {
+  o.lanes = false;
+  o.persistent = false;
+  o.force_split = 1;
+  return o;
+}
 
 /// The default device (PoCL in CI), created once.
 inline const ClContext& cl_context() {

@@ -1,5 +1,5 @@
 // Heun's corrector over the elements' blocks from the last to the first (engine/sim/
-// correct_order.hpp; VOXBREAST_CORRECT_REVERSE forces it here): each element's corrector is its
+// correct_order.hpp; PlanOverrides::correct_reverse forces it here): each element's corrector is its
 // own arithmetic, so the order must change no bit: springs with the general and the short loop
 // (with the packed stage), with and without the volume constraint, and a hyperelastic law.
 #include <gtest/gtest.h>
@@ -15,12 +15,12 @@ namespace vb {
 namespace {
 
 std::unique_ptr<Simulator> make(const Scene& s, const test::Model& m, bool reverse, bool short_loop) {
-  const test::ScopedEnv order("VOXBREAST_CORRECT_REVERSE", reverse ? "1" : "0");
-  const test::ScopedEnv uniform("VOXBREAST_UNIFORM_PATH", short_loop ? "1" : "0");
-  const test::ScopedEnv packed("VOXBREAST_PRED_PACKED", short_loop ? "1" : "0");
-  const test::ScopedEnv list("VOXBREAST_STEP_LIST", "0");
-  const test::OneItemPerElement kernels;
-  return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
+  PlanOverrides o = test::one_item_per_element();
+  o.correct_reverse = reverse;
+  o.uniform_path = short_loop;
+  o.pred_packed = short_loop;
+  o.step_list = false;
+  return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context(), o);
 }
 
 /// u then v after 150 Heun steps, a check between runs of 15 and 135.
@@ -57,10 +57,10 @@ TEST(CorrectOrder, OnlyHeunsCorrectorInElementOrder) {
   const Scene heun = test::mixed_block(Integrator::Heun, false);
   const test::Model m = test::make_model(heun);
   {
-    const test::ScopedEnv list_on("VOXBREAST_STEP_LIST", "1");
-    const test::ScopedEnv order("VOXBREAST_CORRECT_REVERSE", "1");
-    const test::OneItemPerElement kernels;
-    EXPECT_FALSE(Simulator(heun, m.lattice, m.elements, test::cl_context()).correct_reverse());
+    PlanOverrides o = test::one_item_per_element();
+    o.step_list = true;
+    o.correct_reverse = true;
+    EXPECT_FALSE(Simulator(heun, m.lattice, m.elements, test::cl_context(), o).correct_reverse());
   }
   const Scene euler = test::mixed_block(Integrator::SymplecticEuler, false);
   const test::Model me = test::make_model(euler);

@@ -248,18 +248,14 @@ Scene sagging_ogden_block(bool volume, int held = 1) {
 }
 
 /// u then v after 100 Heun steps of `s` from a smooth deformation, with the environment variable
-/// `env` set to `value` while the simulator is made; `check` sees the simulator then.
-std::vector<double> heun_steps_with(const Scene& s, const char* env, const std::string& value,
+/// the launch plan overridden by `o`; `check` sees the simulator then.
+std::vector<double> heun_steps_with(const Scene& s, const PlanOverrides& o,
                                     const std::function<void(const Simulator&)>& check) {
   const test::Model m = test::make_model(s);
   const auto u0 = field(m.lattice, [](const Vec3& X) {
     return Vec3(0.0002 * std::sin(300 * X.z()), 0.0001 * std::cos(400 * X.x()), -0.0002 * std::sin(250 * X.y()));
   });
-  std::unique_ptr<Simulator> made;
-  {
-    const test::ScopedEnv set(env, value);
-    made = std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
-  }
+  const auto made = std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context(), o);
   Simulator& sim = *made;
   check(sim);
   sim.upload(u0, std::vector<double>(u0.size(), 0.0));
@@ -271,8 +267,9 @@ std::vector<double> heun_steps_with(const Scene& s, const char* env, const std::
 }
 
 std::vector<double> split_steps(int split) {
-  return heun_steps_with(sagging_ogden_block(false), "VOXBREAST_FORCE_SPLIT", std::to_string(split),
-                         [&](const Simulator& sim) { EXPECT_EQ(sim.force_split(), split); });
+  PlanOverrides o;
+  o.force_split = split;
+  return heun_steps_with(sagging_ogden_block(false), o, [&](const Simulator& sim) { EXPECT_EQ(sim.force_split(), split); });
 }
 
 // Each element's connections summed by 2 or 4 work-items that meet in local memory (343 elements:
@@ -294,9 +291,11 @@ TEST(HyperelasticKernels, SplitForcePassesMatchOneWorkItemPerElement) {
 TEST(HyperelasticKernels, PairedStressesMatchTwoLaunches) {
   for (const bool volume : {false, true}) {
     const Scene s = sagging_ogden_block(volume, 3);
-    const auto two = heun_steps_with(s, "VOXBREAST_STRESS_PAIR", "0",
-                                     [](const Simulator& sim) { EXPECT_FALSE(sim.stress_pair()); });
-    const auto one = heun_steps_with(s, "VOXBREAST_STRESS_PAIR", "1", [](const Simulator& sim) {
+    PlanOverrides paired, separate;
+    paired.stress_pair = true;
+    separate.stress_pair = false;
+    const auto two = heun_steps_with(s, separate, [](const Simulator& sim) { EXPECT_FALSE(sim.stress_pair()); });
+    const auto one = heun_steps_with(s, paired, [](const Simulator& sim) {
       EXPECT_TRUE(sim.stress_pair());
       EXPECT_EQ(sim.stress_pass_elements(), 5u * 7 * 7);
     });

@@ -1,6 +1,6 @@
 // The CPU stepping kernels on float8 vectors, 8 free elements per work-item
 // (kernels/integrate_lanes.cl, VB_LANES), against the real4 kernels they replace on CPUs
-// (kernels/integrate.cl, VOXBREAST_LANES=0). Run where the default device is a CPU (PoCL in CI);
+// (kernels/integrate.cl, PlanOverrides::lanes = false). Run where the default device is a CPU (PoCL in CI);
 // on a GPU the lanes form is not used and the comparisons skip.
 #include <gtest/gtest.h>
 
@@ -37,10 +37,9 @@ Scene block(bool volume, Integrator integrator = Integrator::Heun) {
 }
 
 std::unique_ptr<Simulator> make_simulator(const Scene& s, const test::Model& m, bool lanes) {
-  setenv("VOXBREAST_LANES", lanes ? "1" : "0", 1);
-  auto sim = std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
-  unsetenv("VOXBREAST_LANES");
-  return sim;
+  PlanOverrides o;
+  o.lanes = lanes;
+  return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context(), o);
 }
 
 /// u then v after 300 steps from rest, checks every 100 (relaxation sets its damping there),
@@ -95,7 +94,7 @@ TEST(LanesStep, UsedOnlyForPlainFloatSpringModels) {
   const Scene plain = block(false);
   const test::Model m = test::make_model(plain);
   if (!make_simulator(plain, m, true)->lanes()) GTEST_SKIP() << "the lanes kernels are used on CPU devices only";
-  EXPECT_FALSE(make_simulator(plain, m, false)->lanes()) << "VOXBREAST_LANES=0";
+  EXPECT_FALSE(make_simulator(plain, m, false)->lanes()) << "lanes = false";
 
   Scene dbl = plain;
   dbl.solver.precision = Precision::Double;

@@ -49,18 +49,16 @@ Scene make_case(Case c) {
 
 /// u then v after 150 Heun steps from rest with checks after steps 50 and 100 (and gravity turned
 /// after step 50 where the scene has it: set_gravity must reach the persistent kernel), the step as one
-/// launch (`persistent`, VOXBREAST_PERSISTENT=1) or one launch per pass; empty when the device
+/// launch (`persistent`, PlanOverrides::persistent) or one launch per pass; empty when the device
 /// has no persistent step.
 std::vector<double> run_case(Case c, bool persistent, int split = 0, int group_limit = 0) {
   const Scene s = make_case(c);
   const test::Model m = test::make_model(s);
-  setenv("VOXBREAST_PERSISTENT", persistent ? "1" : "0", 1);
-  if (split) setenv("VOXBREAST_FORCE_SPLIT", std::to_string(split).c_str(), 1);
-  if (group_limit) setenv("VOXBREAST_PERSISTENT_GROUP_LIMIT", std::to_string(group_limit).c_str(), 1);
-  Simulator sim(s, m.lattice, m.elements, test::cl_context());
-  unsetenv("VOXBREAST_PERSISTENT");
-  unsetenv("VOXBREAST_FORCE_SPLIT");
-  unsetenv("VOXBREAST_PERSISTENT_GROUP_LIMIT");
+  PlanOverrides o;
+  o.persistent = persistent;
+  if (split) o.force_split = split;
+  if (group_limit) o.persistent_group_limit = std::size_t(group_limit);
+  Simulator sim(s, m.lattice, m.elements, test::cl_context(), o);
   if (sim.persistent_step() != persistent) return {};
   for (int k = 0; k < 3; ++k) {
     sim.advance(50);
@@ -111,14 +109,12 @@ TEST(PersistentStepGpu, MatchesWithEveryForceSplitAndFewGroups) {
 // with one and two work-items per element. Runs everywhere.
 TEST(PersistentStep, KernelBuildsOnEveryDevice) {
   for (const Case c : {Case::SpringsVolume, Case::OgdenVolumeEveryThird, Case::OgdenPlates})
-    for (const char* split : {"1", "2"}) {
+    for (const int split : {1, 2}) {
       const Scene s = make_case(c);
       const test::Model m = test::make_model(s);
-      std::unique_ptr<Simulator> sim;
-      {
-        const test::ScopedEnv set("VOXBREAST_FORCE_SPLIT", split);
-        sim = std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
-      }
+      PlanOverrides o;
+      o.force_split = split;
+      const auto sim = std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context(), o);
       std::string options = sim->build_options();
       const std::string off = "-DVB_PERSISTENT=0";
       const std::size_t at = options.find(off);

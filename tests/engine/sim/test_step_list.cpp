@@ -1,6 +1,6 @@
 // The stepping kernels over a list of the free elements (kernels/common.cl, VB_STEP_LIST; on by
 // default on GPUs for large models with a quarter or more held, engine/sim/step_list_rule.hpp;
-// VOXBREAST_STEP_LIST=1 forces it here) against the same kernels over every element: each
+// PlanOverrides::step_list forces it here) against the same kernels over every element: each
 // element's arithmetic is the same, so the two must agree to the bit, also after the host moves
 // the held elements (their copy in the predicted-stage arrays is the host's to keep).
 #include <gtest/gtest.h>
@@ -21,11 +21,11 @@ namespace {
 std::vector<double> run(const Scene& s, bool listed) {
   const test::Model m = test::make_model(s);
   const std::unique_ptr<Simulator> made = [&] {
-    const test::ScopedEnv list("VOXBREAST_STEP_LIST", listed ? "1" : "0");
+    PlanOverrides o = test::one_item_per_element();  // the real4 kernels, which the list is for
+    o.step_list = listed;
     // the same connection loop in both (GPUs: the short loop is off by default with the list)
-    const test::ScopedEnv path("VOXBREAST_UNIFORM_PATH", "0");
-    const test::OneItemPerElement kernels;  // the real4 kernels, which the list is for
-    return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
+    o.uniform_path = false;
+    return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context(), o);
   }();
   Simulator& sim = *made;
   EXPECT_EQ(sim.step_list(), listed);

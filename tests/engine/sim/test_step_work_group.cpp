@@ -1,5 +1,5 @@
-// The stepping kernels' work-group size (engine/sim/step_work_group.hpp; VOXBREAST_STEP_WG forces
-// it here): each element's arithmetic does not depend on which group steps it, so groups of 32 and
+// The stepping kernels' work-group size (engine/sim/step_work_group.hpp; PlanOverrides::step_work_group
+// forces it here): each element's arithmetic does not depend on which group steps it, so groups of 32 and
 // 256 must agree to the bit, with and without the step list and the volume constraint, for every
 // integrator, springs and a hyperelastic law.
 #include <gtest/gtest.h>
@@ -17,16 +17,14 @@ namespace vb {
 namespace {
 
 /// u then v after 150 steps with the stepping kernels in groups of `wg` work-items.
-std::vector<double> run(const Scene& s, const char* wg, bool listed) {
+std::vector<double> run(const Scene& s, std::size_t wg, bool listed) {
   const test::Model m = test::make_model(s);
-  const std::unique_ptr<Simulator> made = [&] {
-    const test::ScopedEnv size("VOXBREAST_STEP_WG", wg);
-    const test::ScopedEnv list("VOXBREAST_STEP_LIST", listed ? "1" : "0");
-    const test::OneItemPerElement kernels;
-    return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
-  }();
+  PlanOverrides o = test::one_item_per_element();
+  o.step_work_group = wg;
+  o.step_list = listed;
+  const auto made = std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context(), o);
   Simulator& sim = *made;
-  EXPECT_EQ(sim.step_work_group(), std::size_t(std::stoi(wg)));
+  EXPECT_EQ(sim.step_work_group(), wg);
   EXPECT_EQ(sim.step_list(), listed);
   sim.advance(150);
   EXPECT_EQ(sim.check().nonfinite_elements, 0);
@@ -38,7 +36,7 @@ TEST(StepWorkGroup, GroupSizeChangesNoBit) {
     for (const bool volume : {false, true})
       for (const bool listed : {false, true}) {
         const Scene s = test::mixed_block(integrator, volume);
-        const std::vector<double> small = run(s, "32", listed), large = run(s, "256", listed);
+        const std::vector<double> small = run(s, 32, listed), large = run(s, 256, listed);
         EXPECT_EQ(test::differing_values(small, large), 0u)
             << "integrator " << int(integrator) << (volume ? ", volume" : "") << (listed ? ", list" : "");
       }
@@ -46,7 +44,7 @@ TEST(StepWorkGroup, GroupSizeChangesNoBit) {
 
 TEST(StepWorkGroup, GroupSizeChangesNoBitHyperelastic) {
   const Scene s = test::neo_hookean_mixed_block();
-  EXPECT_EQ(test::differing_values(run(s, "32", false), run(s, "256", false)), 0u);
+  EXPECT_EQ(test::differing_values(run(s, 32, false), run(s, 256, false)), 0u);
 }
 
 // 256 from 131,072 elements (H200: 2–12% from 262k up, level below; docs/PERFORMANCE.md).
@@ -57,16 +55,16 @@ TEST(StepWorkGroup, DefaultRuleTakesLargerGroupsForLargeModels) {
   EXPECT_EQ(default_step_work_group(1520875), 256u);
 }
 
-TEST(StepWorkGroup, OverrideNamesTheVariableAndTheLimits) {
-  EXPECT_EQ(step_work_group_override("64", 1024), 64u);
-  EXPECT_EQ(step_work_group_override("1024", 1024), 1024u);
-  for (const char* bad : {"100", "0", "16", "2048", "256x", "", "-256", "abc"}) {
+TEST(StepWorkGroup, OverrideNamesTheLimits) {
+  EXPECT_EQ(checked_step_work_group(64, 1024), 64u);
+  EXPECT_EQ(checked_step_work_group(1024, 1024), 1024u);
+  for (const std::size_t bad : {100, 0, 16, 2048, 250}) {
     try {
-      step_work_group_override(bad, 1024);
-      ADD_FAILURE() << "accepted '" << bad << "'";
+      checked_step_work_group(bad, 1024);
+      ADD_FAILURE() << "accepted " << bad;
     } catch (const Error& e) {
       const std::string what = e.what();
-      EXPECT_NE(what.find("VOXBREAST_STEP_WG"), std::string::npos) << what;
+      EXPECT_NE(what.find("step_work_group"), std::string::npos) << what;
       EXPECT_NE(what.find("multiple of 32"), std::string::npos) << what;
       EXPECT_NE(what.find("1024"), std::string::npos) << what;
     }
@@ -76,9 +74,9 @@ TEST(StepWorkGroup, OverrideNamesTheVariableAndTheLimits) {
 TEST(StepWorkGroup, SimulatorRefusesABadOverride) {
   const Scene s = test::mixed_block(Integrator::Heun, false);
   const test::Model m = test::make_model(s);
-  const test::ScopedEnv size("VOXBREAST_STEP_WG", "48");
-  const test::OneItemPerElement kernels;
-  EXPECT_THROW(Simulator(s, m.lattice, m.elements, test::cl_context()), Error);
+  PlanOverrides o = test::one_item_per_element();
+  o.step_work_group = 48;
+  EXPECT_THROW(Simulator(s, m.lattice, m.elements, test::cl_context(), o), Error);
 }
 
 }  // namespace

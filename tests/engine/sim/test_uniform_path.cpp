@@ -1,6 +1,6 @@
 // The short connection loop of linear springs for elements whose neighbours share their modulus
 // and mass (kernels/lattice_forces.cl, lattice_force_uniform; engine/sim/uniform_neighbourhood.hpp;
-// on by default on GPUs, VOXBREAST_UNIFORM_PATH=1 forces it here) against the general loop.
+// on by default on GPUs, PlanOverrides::uniform_path forces it here) against the general loop.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -67,11 +67,10 @@ TEST(UniformNeighbourhood, MarksElementsWhoseNeighboursShareModulusAndMass) {
 /// not (0) or by default (-1); neither the one-launch step (GPUs) nor the lanes kernels (CPUs,
 /// float) have the short loop, so both are off.
 std::unique_ptr<Simulator> make_simulator(const Scene& s, const test::Model& m, bool uniform, int packed) {
-  const test::ScopedEnv path("VOXBREAST_UNIFORM_PATH", uniform ? "1" : "0");
-  const test::OneItemPerElement kernels;
-  std::optional<test::ScopedEnv> pack;
-  if (packed >= 0) pack.emplace("VOXBREAST_PRED_PACKED", packed == 1 ? "1" : "0");
-  return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
+  PlanOverrides o = test::one_item_per_element();
+  o.uniform_path = uniform;
+  if (packed >= 0) o.pred_packed = packed == 1;
+  return std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context(), o);
 }
 
 /// u then v after 300 steps from rest (checks every 100: relaxation sets its damping there).

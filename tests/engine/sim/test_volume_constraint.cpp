@@ -94,7 +94,7 @@ INSTANTIATE_TEST_SUITE_P(Precisions, VolumeKernels,
 /// the simulator is kept there (the constraint's scalars after the run).
 RunOutput squash_block(bool preserve, Precision precision = Precision::Float, double tolerance = 1e-5,
                        VolumeSpec::Predictor predictor = VolumeSpec::Predictor::Pressure,
-                       std::unique_ptr<Simulator>* sim_out = nullptr) {
+                       std::unique_ptr<Simulator>* sim_out = nullptr, const PlanOverrides& plan = {}) {
   const double h = 0.005;
   Scene s = test::box_scene(10, 10, 11, h, 3000);  // ρgL/E ≈ 16% strain at the base
   s.model.shapes[0].min_m.z() = -h;                 // the layer below z = 0 is held
@@ -110,7 +110,7 @@ RunOutput squash_block(bool preserve, Precision precision = Precision::Float, do
   s.volume.preserve = preserve;
   s.volume.predictor = predictor;
   const test::Model m = test::make_model(s);
-  auto sim = std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context());
+  auto sim = std::make_unique<Simulator>(s, m.lattice, m.elements, test::cl_context(), plan);
   RunOutput out = run_simulation(s, m.lattice, m.elements, *sim);
   if (sim_out) *sim_out = std::move(sim);
   return out;
@@ -140,11 +140,13 @@ TEST(VolumeConstraint, HoldsTheVolumeOfASquashedBlock) {
 // lanes kernels on CPUs, double with the real4 ones. On NVIDIA GPUs with one launch per pass: the
 // one-launch step of spring models (kernels/persistent.cl) projects the predicted stage.
 TEST(VolumeConstraint, LaggedPressureReachesTheProjectedEquilibrium) {
-  const test::ScopedEnv launches("VOXBREAST_PERSISTENT", "0");
+  PlanOverrides launched;
+  launched.persistent = false;
   for (const auto& [precision, tolerance] : {std::pair{Precision::Double, 1e-8}, std::pair{Precision::Float, 1e-5}}) {
     std::unique_ptr<Simulator> lagged, projected;
-    const RunOutput a = squash_block(true, precision, tolerance, VolumeSpec::Predictor::Pressure, &lagged);
-    const RunOutput b = squash_block(true, precision, tolerance, VolumeSpec::Predictor::Projection, &projected);
+    const RunOutput a = squash_block(true, precision, tolerance, VolumeSpec::Predictor::Pressure, &lagged, launched);
+    const RunOutput b =
+        squash_block(true, precision, tolerance, VolumeSpec::Predictor::Projection, &projected, launched);
     const char* name = precision == Precision::Double ? "double" : "float";
     EXPECT_TRUE(lagged->volume_predictor_pressure());
     EXPECT_FALSE(projected->volume_predictor_pressure());
@@ -213,7 +215,7 @@ RigidStep rigid_step(const Vec3& omega, const Vec3& velocity) {
 }
 
 /// 150 Heun steps of the squashed block from rest, the projection as one launch (volume_project,
-/// VOXBREAST_VOLUME_LAUNCHES=1), two (2: volume_partials, volume_apply) or left pending for the
+/// PlanOverrides::volume_launches = 1), two (2: volume_partials, volume_apply) or left pending for the
 /// next kernels (0: volume_pending); with checks (which apply a pending projection) after steps 50
 /// and 100; two-term Ogden instead of springs when `ogden`, projecting every `every` steps.
 /// Returns u then v.
@@ -230,13 +232,12 @@ std::vector<double> project_steps(int launches, bool ogden = false, int every = 
   s.solver.dashpot_ratio = 0.1;
   s.volume.preserve = true;
   const test::Model m = test::make_model(s);
-  setenv("VOXBREAST_VOLUME_LAUNCHES", std::to_string(launches).c_str(), 1);
+  PlanOverrides o;
+  o.volume_launches = launches;
   // the launches named here: on NVIDIA GPUs a spring model's Heun step is otherwise one persistent
   // launch, projections included, and every form would compare equal (test_persistent_step.cpp)
-  setenv("VOXBREAST_PERSISTENT", "0", 1);
-  Simulator sim(s, m.lattice, m.elements, test::cl_context());
-  unsetenv("VOXBREAST_VOLUME_LAUNCHES");
-  unsetenv("VOXBREAST_PERSISTENT");
+  o.persistent = false;
+  Simulator sim(s, m.lattice, m.elements, test::cl_context(), o);
   EXPECT_EQ(sim.volume_launches(), launches);
   for (int k = 0; k < 3; ++k) {
     sim.advance(50);
@@ -256,7 +257,7 @@ TEST(VolumeConstraint, OneLaunchProjectionMatchesTwoLaunches) {
   EXPECT_LE(test::relative_difference(project_steps(1), project_steps(2)), 1e-12);
 }
 
-// VOXBREAST_VOLUME_LAUNCHES=0: no volume_apply in the step; the stress pass and the stepping
+// Folded projections (volume_launches = 0): no volume_apply in the step; the stress pass and the stepping
 // kernels read every projected state as u + λ·w·g, v − μ·w·g. A reader that missed the projection
 // (the stress pass, a neighbour's or the element's own u or v, the state a check reads) or one that
 // applied the wrong one (the state's instead of the predicted stage's) gives another trajectory.
