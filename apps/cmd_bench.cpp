@@ -309,16 +309,13 @@ Command add_bench(CLI::App& app) {
                                          "enqueue time, the device's time alone, the timed step) and the device time "
                                          "and launches per step of each kernel (a second run of each block on a "
                                          "profiling queue)");
-<<<<<<< HEAD
   sub->add_option("--job", o->jobs,
                   "run this scene end to end like 'simulate' (into OUT/job_N/), timing each phase and the image "
                   "outputs' peak memory; repeatable")
       ->check(CLI::ExistingFile);
-=======
   sub->add_option("--plan", o->plan,
                   "throughput: launch-plan overrides to compare schedules on a device, e.g. lanes=0,step_list=1 "
                   "(keys in engine/sim/launch_plan.hpp; docs/PERFORMANCE.md)");
->>>>>>> plan
   sub->add_flag("--dry-run", o->dry_run, "list the scenes and cases without running them");
   sub->add_flag("--haptic", o->haptic, "haptic rate: a probe pressing a block, force output at 1 kHz (with "
                                        "--no-study: only this)");
