@@ -1,8 +1,9 @@
 // Hyperelastic elements (compiled when VB_HYPER is 1). Pass 1, element_stress, computes each
 // element's deformation gradient by least squares over its existing neighbours,
 //   F = A·B⁻¹,  A = Σ Δx ΔXᵀ,  B = Σ ΔX ΔXᵀ  (ΔX = h·d rest offsets, Δx deformed),
-// the law's first Piola-Kirchhoff stress P(F), and Q = V·P·B⁻¹ (stored with C = FᵀF: hyper_store).
-// The energy V·W(F_e) then puts force −Q_e·(h·d) on each neighbour at offset h·d and +Q_e·Σ h·d on
+// the first Piola-Kirchhoff stress P(F) of the law's isochoric part, and Q = V·P·B⁻¹ (stored with
+// C = FᵀF: hyper_store). The volumetric part is not per element: it is the dual cells' energy
+// (dual_cell_volumetric_force, gathered in pass 2). The energy V·W_iso(F_e) puts force −Q_e·(h·d) on each neighbour at offset h·d and +Q_e·Σ h·d on
 // the element itself (pass 2 gathers them in lattice_force): total force and torque vanish and
 // rigid motions give none.
 //
@@ -148,22 +149,11 @@ inline mat3 mat3_load(global const real4* rows, uint e) {
 }
 
 // J clamped for the isochoric terms: W_iso uses J_c = max(J, floor), so below the floor J_c is a
-// constant and the isochoric stress has no C⁻¹ (J-derivative) term. The volumetric stress is
-// added as P_vol = κ(J − 1)·cof F (= κJ(J − 1)·F⁻ᵀ), which needs no inverse. Both stay finite for a
-// crushed (J = 0) or inverted (J < 0) element, and κ(J − 1)·cof F pushes it back towards J = 1.
+// constant and the isochoric stress has no C⁻¹ (J-derivative) term and stays finite for a crushed
+// (J = 0) or inverted (J < 0) element. The volumetric energy is not the element's: it is that of
+// the dual cells (dual_cell_volumetric_force below), whose κ(J_c − 1) pushes a crushed or inverted
+// cell back towards J_c = 1.
 #define VB_J_FLOOR ((real)0.05)
-
-// cof F = J·F⁻ᵀ: columns f2×f3, f3×f1, f1×f2 of F's columns f1, f2, f3
-inline mat3 mat3_cofactor(mat3 F) {
-  mat3 r;
-  for (int c = 0; c < 3; ++c) {
-    const int a = (c + 1) % 3, b = (c + 2) % 3;
-    r.m[0][c] = F.m[1][a] * F.m[2][b] - F.m[2][a] * F.m[1][b];
-    r.m[1][c] = F.m[2][a] * F.m[0][b] - F.m[0][a] * F.m[2][b];
-    r.m[2][c] = F.m[0][a] * F.m[1][b] - F.m[1][a] * F.m[0][b];
-  }
-  return r;
-}
 
 // Isochoric second Piola-Kirchhoff stress of Mooney-Rivlin (neo-Hookean when C01 = 0) from
 // invariants: S = 2C10 J^(−2/3)(I − I1/3 C⁻¹) + 2C01 J^(−4/3)(I1 I − C − 2/3 I2 C⁻¹) (the C⁻¹ terms
@@ -358,11 +348,7 @@ inline void element_stress_one(uint e, global const real4* u, global uchar* aren
   const mat3 C = mat3_transpose_mul(F, F);
   const mat3 S = law == 1 ? stress_invariants(C, J, (real)0.5 * mat[2], (real)-0.5 * mat[3])
                           : stress_ogden(C, J, mat);
-  mat3 P = mat3_mul(F, S);  // isochoric part, then the volumetric κ(J − 1)·cof F
-  const mat3 cof = mat3_cofactor(F);
-  const real vol = mat[8] * (J - 1);
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) P.m[a][b] += vol * cof.m[a][b];
+  mat3 P = mat3_mul(F, S);  // isochoric only: the volumetric energy is the dual cells' (below)
 #if VB_REST_OFFSET
   P = mat3_mul(P, mat3_transpose(R0));
   for (int a = 0; a < 3; ++a)
@@ -449,4 +435,104 @@ kernel void rest_frame(global const real4* u0, global const uchar* arena, uint8 
   frame_out[3 * e].w = J0;
 }
 #endif
+// Volumetric energy from the dual cells (docs/PHYSICS.md, "Volumetric energy"). A dual cell is
+// the trilinear hexahedron whose 8 corners are neighbouring element centres; the body of
+// hyperelastic tissue is the union of the complete ones, so their volumes add up to the body's
+// volume and no non-affine (swirling, sliding) state can hide a change of it. Cell c carries
+//   V0_c·κ_c/2·(J_c − 1)²,   J_c = V_c/V0_c,   κ_c = ⅛·Σ_corners κ (0 for spring tissue),
+// so its corner a feels −κ_c·(J_c − 1)·∂V_c/∂x_a. Each element gathers this from the ≤ 8 complete
+// cells around it (no scatter, no atomics), computing their volumes from its 3×3×3 neighbourhood.
+
+// The two Gauss points on [0, 1]: (1 ∓ 1/√3)/2.
+#define VB_GAUSS_LO ((real)0.21132486540518711775)
+#define VB_GAUSS_HI ((real)0.78867513459481288225)
+
+// Volume of the trilinear hexahedron with corners q[i + 2j + 4k] (local coordinates (i, j, k) ∈
+// {0, 1}³; q[0] is the corner the gradient is taken at) and that volume's gradient with respect to
+// q[0] in g0. V = ∫ det(∂x/∂ξ) dξ over the unit cube; det(∂x/∂ξ) has degree ≤ 2 in each of ξ, η,
+// ζ, so the 2×2×2 Gauss rule is exact. ∂V/∂q[0] = ∫ cof(∂x/∂ξ)·∇_ξN₀ dξ with the same rule,
+// N₀ = (1 − ξ)(1 − η)(1 − ζ). Negative when the local axes are left-handed.
+inline real trilinear_volume_grad0(const real4 q[8], real4* g0) {
+  // edge vectors along ξ (e_x), η (e_y) and ζ (e_z), each at its 4 positions (i, j, k bits)
+  const real4 ex[4] = {q[1] - q[0], q[3] - q[2], q[5] - q[4], q[7] - q[6]};
+  const real4 ey[4] = {q[2] - q[0], q[3] - q[1], q[6] - q[4], q[7] - q[5]};
+  const real4 ez[4] = {q[4] - q[0], q[5] - q[1], q[6] - q[2], q[7] - q[3]};
+  real V = 0;
+  real4 g = (real4)(0);
+  for (int gp = 0; gp < 8; ++gp) {
+    const real s = gp & 1 ? VB_GAUSS_HI : VB_GAUSS_LO, t = gp & 2 ? VB_GAUSS_HI : VB_GAUSS_LO,
+               r = gp & 4 ? VB_GAUSS_HI : VB_GAUSS_LO;
+    const real4 xs = (1 - t) * (1 - r) * ex[0] + t * (1 - r) * ex[1] + (1 - t) * r * ex[2] + t * r * ex[3];
+    const real4 xt = (1 - s) * (1 - r) * ey[0] + s * (1 - r) * ey[1] + (1 - s) * r * ey[2] + s * r * ey[3];
+    const real4 xr = (1 - s) * (1 - t) * ez[0] + s * (1 - t) * ez[1] + (1 - s) * t * ez[2] + s * t * ez[3];
+    const real4 c_s = cross(xt, xr), c_t = cross(xr, xs), c_r = cross(xs, xt);  // columns of cof
+    V += dot3(xs, c_s);
+    g -= (1 - t) * (1 - r) * c_s + (1 - s) * (1 - r) * c_t + (1 - s) * (1 - t) * c_r;
+  }
+  *g0 = (real)0.125 * g;
+  return (real)0.125 * V;
+}
+
+// Force on element e from the volumetric energy of the complete dual cells around it (N). ui is
+// e's displacement as the caller has it (pending projection applied); the neighbours' are read from
+// u as lattice_force_pending reads them. Rest volumes are h³, or with VB_REST_OFFSET those of the
+// unloaded state's cells.
+inline real4 dual_cell_volumetric_force(uint e, real4 ui, global const real4* u, global const uint* cell_of,
+                                        global const int* grid, int sy, int sz, real h,
+                                        global const uchar* tissue_of, global const real* materials,
+                                        global const real4* rest_offset, VB_PENDING_PARAMS) {
+  const int cell = (int)cell_of[e];
+  real4 x[27];  // neighbourhood positions relative to e, index (i + 1) + 3(j + 1) + 9(k + 1)
+  real kappa[27];
+#if VB_REST_OFFSET
+  real4 x0[27];
+  const real4 u0e = rest_offset[e];
+#endif
+  for (int m = 0; m < 27; ++m) {
+    const int di = m % 3 - 1, dj = (m / 3) % 3 - 1, dk = m / 9 - 1;
+    const int jn = m == 13 ? (int)e : grid[cell + di + sy * dj + sz * dk];
+    const uint j = jn >= 0 ? (uint)jn : e;  // a missing neighbour reads e and carries κ = 0
+    real4 uj = u[j], wg = (real4)(0);
+    if (m != 13) pending_u(&uj, &wg, j, VB_PENDING_ARGS);
+    else uj = ui;
+    const real4 hd = (real4)(h * di, h * dj, h * dk, 0);
+    x[m] = hd + xyz0(uj - ui);
+    kappa[m] = jn >= 0 ? materials[VB_MAT_STRIDE * tissue_of[j] + 8] : (real)-1;  // −1: absent
+#if VB_REST_OFFSET
+    x0[m] = hd + xyz0(rest_offset[j] - u0e);
+#endif
+  }
+  real4 f = (real4)(0);
+  for (int o = 0; o < 8; ++o) {  // the cell in octant (±1, ±1, ±1) of e
+    const int si = o & 1 ? -1 : 1, sj = o & 2 ? -1 : 1, sk = o & 4 ? -1 : 1;
+    real4 q[8];
+    real kappa_sum = 0;
+    int complete = 1;
+#if VB_REST_OFFSET
+    real4 q0[8];
+#endif
+    for (int c = 0; c < 8; ++c) {
+      const int m = (1 + si * (c & 1)) + 3 * (1 + sj * ((c >> 1) & 1)) + 9 * (1 + sk * ((c >> 2) & 1));
+      q[c] = x[m];
+      complete &= kappa[m] >= 0;
+      kappa_sum += fmax(kappa[m], (real)0);
+#if VB_REST_OFFSET
+      q0[c] = x0[m];
+#endif
+    }
+    if (!complete || kappa_sum == 0) continue;
+    real4 g;
+    const real V = trilinear_volume_grad0(q, &g);  // both carry the local axes' handedness si·sj·sk
+#if VB_REST_OFFSET
+    real4 g_unused;
+    const real V0 = trilinear_volume_grad0(q0, &g_unused);
+#else
+    const real V0 = (real)(si * sj * sk) * h * h * h;
+#endif
+    // −κ_c(J_c − 1)·∂V_c/∂x_e: J_c = V/V0 (the handedness cancels), ∂V_c/∂x_e = si·sj·sk·g
+    f -= (real)0.125 * kappa_sum * (V / V0 - 1) * (real)(si * sj * sk) * g;
+  }
+  return f;
+}
+
 #endif  // VB_HYPER

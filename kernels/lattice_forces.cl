@@ -239,6 +239,12 @@ VB_INLINE real4 lattice_force_pending(uint e, real4 ui, real4 vi, global const r
   }
 #if VB_HYPER
   if (VB_LAW_HYPER(law_i)) f += mat3_apply(mat3_load(Qs, e), own_offsets);
+  // the dual cells' volumetric energy, once per element (the part of a split force that starts at
+  // the first connection); spring elements that are corners of a cell with hyperelastic corners
+  // feel it too
+  if (d_lo == 0)
+    f += dual_cell_volumetric_force(e, ui, u, cell_of, grid, sy, sz, h, tissue_of, materials, rest_offset,
+                                    VB_PENDING_ARGS);
 #endif
   return f;
 }

@@ -56,7 +56,10 @@ ElementArrays make_element_arrays(const Scene& scene, const Lattice& lattice) {
       const HyperelasticLaw law = law_of(m);
       const double mu0 = law.shear_modulus_pa();
       E_of_tissue.push_back(2.5 * mu0);
-      stability_of_tissue.push_back(law.p_wave_modulus_pa() / 1.2 + 2 * scene.solver.hourglass * 2.5 * mu0);
+      // The isochoric part's P-wave modulus 4/3·μ₀ over the lattice's C11/E = 1.2 and the
+      // hourglass springs; the dual cells' volumetric stiffness is added to the Gershgorin rows
+      // directly (engine/sim/time_step.cpp, dual_cell_row).
+      stability_of_tissue.push_back(4.0 / 3.0 * mu0 / 1.2 + 2 * scene.solver.hourglass * 2.5 * mu0);
       row[0] = law.kind == HyperelasticLaw::Kind::Ogden ? 2 : 1;
       row[1] = law.terms;
       for (int p = 0; p < law.terms; ++p) {

@@ -60,6 +60,7 @@ HostReference::HostReference(const Lattice& lattice, const ElementArrays& elemen
     neighbours_.push_back(lattice.neighbours(e));
     stiffness_.push_back(connection_stiffness(lattice, elements.youngs_modulus_pa, e));
   }
+  if (elements.hyperelastic) cells_ = dual_cells();
 }
 
 void HostReference::element_stresses(const std::vector<double>& u, std::vector<Eigen::Matrix3d>& F,
@@ -84,8 +85,67 @@ void HostReference::element_stresses(const std::vector<double>& u, std::vector<E
     if (B.determinant() < 0.5) continue;  // as the kernel: neighbours do not span 3-D
     const Eigen::Matrix3d Bi = B.inverse();
     F[e] = A * Bi / h;
-    Q[e] = dual_volume_fraction(neighbours_[e]) * h * first_piola(*law, F[e]) * Bi;  // V = w·h³
+    HyperelasticLaw isochoric = *law;  // the volumetric energy is the dual cells' (below)
+    isochoric.bulk_modulus_pa = 0;
+    Q[e] = dual_volume_fraction(neighbours_[e]) * h * first_piola(isochoric, F[e]) * Bi;  // V = w·h³
   }
+}
+
+std::vector<HostReference::DualCell> HostReference::dual_cells() const {
+  // the cell whose lowest corner is element e: its corners e + (i, j, k), i, j, k ∈ {0, 1}
+  const auto& offsets = neighbour_offsets();
+  std::array<int, 8> direction{};  // neighbour index of corner (i, j, k), i + 2j + 4k ≥ 1
+  for (int d = 0; d < 26; ++d) {
+    const auto& o = offsets[d];
+    if (o[0] >= 0 && o[1] >= 0 && o[2] >= 0) direction[o[0] + 2 * o[1] + 4 * o[2]] = d;
+  }
+  std::vector<DualCell> cells;
+  for (std::size_t e = 0; e < lattice_.element_count(); ++e) {
+    DualCell c;
+    c.corner[0] = e;
+    bool complete = true;
+    for (int a = 1; a < 8 && complete; ++a) {
+      const std::int32_t j = neighbours_[e][direction[a]];
+      complete = j >= 0;
+      c.corner[a] = std::size_t(j);
+    }
+    if (!complete) continue;
+    for (const std::size_t a : c.corner) {
+      const auto& law = laws_[lattice_.tissue_of_element[a]];
+      if (law) c.bulk_modulus_pa += law->bulk_modulus_pa / 8;
+    }
+    if (c.bulk_modulus_pa > 0) cells.push_back(c);
+  }
+  return cells;
+}
+
+TrilinearVolume HostReference::cell_volume(const DualCell& c, const std::vector<double>& u) const {
+  std::array<Vec3, 8> x;  // lattice frame, relative to corner 0's rest position
+  for (int a = 0; a < 8; ++a) {
+    const std::size_t e = c.corner[a];
+    x[a] = lattice_.spacing_m * Vec3(a & 1, (a >> 1) & 1, (a >> 2) & 1) + Vec3(u[3 * e], u[3 * e + 1], u[3 * e + 2]);
+  }
+  return trilinear_volume(x);
+}
+
+double HostReference::elastic_energy(const std::vector<double>& u) const {
+  const double h = lattice_.spacing_m, V0 = h * h * h;
+  double energy = 0;
+  if (!el_.hyperelastic) return energy;
+  std::vector<Eigen::Matrix3d> F, Q;
+  element_stresses(u, F, Q);
+  for (std::size_t e = 0; e < lattice_.element_count(); ++e) {
+    const auto& law = laws_[lattice_.tissue_of_element[e]];
+    if (!law) continue;  // a strand without a fit has F = I: no energy
+    HyperelasticLaw isochoric = *law;
+    isochoric.bulk_modulus_pa = 0;
+    energy += dual_volume_fraction(neighbours_[e]) * V0 * strain_energy(isochoric, F[e]);
+  }
+  for (const DualCell& c : cells_) {
+    const double J = cell_volume(c, u).volume_m3 / V0;
+    energy += V0 * 0.5 * c.bulk_modulus_pa * (J - 1) * (J - 1);
+  }
+  return energy;
 }
 
 std::vector<double> HostReference::lattice_forces(const std::vector<double>& u,
@@ -126,6 +186,14 @@ std::vector<double> HostReference::lattice_forces(const std::vector<double>& u,
     }
     if (hyper(e)) fe += Q[e] * own_offsets;
     for (int c = 0; c < 3; ++c) f[3 * e + c] = fe[c];
+  }
+  // The dual cells' volumetric energy V0·κ_c/2·(V/V0 − 1)², scattered to each cell's 8 corners.
+  const double V0 = h * h * h;
+  for (const DualCell& c : cells_) {
+    const TrilinearVolume cell = cell_volume(c, u);
+    const double pressure = c.bulk_modulus_pa * (cell.volume_m3 / V0 - 1);
+    for (int a = 0; a < 8; ++a)
+      for (int k = 0; k < 3; ++k) f[3 * c.corner[a] + k] -= pressure * cell.gradient_m2[a][k];
   }
   return f;
 }

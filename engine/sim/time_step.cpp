@@ -6,6 +6,7 @@
 #include <complex>
 
 #include "engine/error.hpp"
+#include "engine/lattice/dual_cells.hpp"
 #include "engine/material/linear_spring.hpp"
 #include "engine/sim/parallel_chunks.hpp"
 #include "engine/sim/triangle_contact.hpp"
@@ -26,6 +27,29 @@ const std::array<std::array<double, 26>, 3>& row_weights() {
     return out;
   }();
   return w;
+}
+
+/// The Gershgorin row (N/m, the same for x, y and z) of the dual cells' volumetric energy at
+/// element e (kernels/hyperelastic.cl, dual_cell_volumetric_force): a complete cell's stiffness at
+/// rest is κ_c/h³·b·bᵀ with b = ∂V/∂x, whose 8 corner entries are (±1, ±1, ±1)·h²/4, so each of
+/// its rows sums to κ_c/h³·(h²/4)·24·(h²/4) = 1.5·κ_c·h; κ_c = ⅛·Σ of its corners' κ (0 for
+/// spring tissue).
+double dual_cell_row(const Lattice& lattice, const ElementArrays& el, const std::array<std::int32_t, 26>& nb,
+                     std::size_t e) {
+  if (!el.hyperelastic) return 0;
+  const auto kappa = [&](std::size_t a) { return el.material_table[lattice.tissue_of_element[a]][8]; };
+  double row = 0;
+  for (const std::uint32_t mask : octant_masks()) {
+    double kappa_sum = kappa(e);
+    bool complete = true;
+    for (int d = 0; d < 26 && complete; ++d) {
+      if (!(mask & (1u << d))) continue;
+      complete = nb[d] >= 0;
+      if (complete) kappa_sum += kappa(std::size_t(nb[d]));
+    }
+    if (complete) row += 1.5 * (kappa_sum / 8) * lattice.spacing_m;
+  }
+  return row;
 }
 
 /// Gershgorin row bounds of M⁻¹K and M⁻¹C (dashpots only) of a free element, over its 3 rows;
@@ -50,9 +74,10 @@ Rows element_rows(const Lattice& lattice, const ElementArrays& el, double dashpo
     }
   }
   const auto& w = row_weights();
+  const double volumetric = dual_cell_row(lattice, el, nb, e);
   Rows r;
   for (int a = 0; a < 3; ++a) {
-    double k_row = 0, c_row = 0;
+    double k_row = volumetric, c_row = 0;
     for (int d = 0; d < 26; ++d) {
       if (k[d] == 0) continue;
       k_row += 2 * k[d] * w[a][d];

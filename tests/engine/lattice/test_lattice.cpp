@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include "engine/error.hpp"
+#include "engine/lattice/dual_cells.hpp"
 #include "engine/lattice/lattice.hpp"
 #include "engine/lattice/voxelise.hpp"
 #include "tests/engine/sim/sim_fixtures.hpp"
@@ -210,6 +212,68 @@ TEST(Lattice, ModelWithNoElementsIsAnError) {
   const Lattice lat = build_lattice(voxelise_shapes(s));
   EXPECT_EQ(lat.element_count(), 0u);
   EXPECT_THROW(make_element_arrays(s, lat), Error);
+}
+
+}  // namespace
+}  // namespace vb
+
+namespace vb {
+namespace {
+
+std::array<Eigen::Vector3d, 8> unit_cell_corners(double h) {
+  std::array<Eigen::Vector3d, 8> p;
+  for (int a = 0; a < 8; ++a) p[a] = h * Eigen::Vector3d(a & 1, (a >> 1) & 1, (a >> 2) & 1);
+  return p;
+}
+
+// The trilinear cell volume: det(A)·h³ for any affine map A (the gradient then cof(A)·∂V₀/∂p),
+// the same under a translation, and its gradient that of its volume (central differences) for a
+// cell with warped faces.
+TEST(DualCells, TrilinearVolumeIsExactForAffineMapsAndItsGradientIsConsistent) {
+  const double h = 0.002;
+  Eigen::Matrix3d A;
+  A << 1.1, 0.2, -0.1, 0.05, 0.9, 0.3, -0.2, 0.1, 1.2;
+  auto p = unit_cell_corners(h);
+  for (auto& x : p) x = A * x + Eigen::Vector3d(0.01, -0.02, 0.03);
+  const TrilinearVolume affine = trilinear_volume(p);
+  EXPECT_NEAR(affine.volume_m3, A.determinant() * h * h * h, 1e-14 * h * h * h);
+  const Eigen::Matrix3d cof = A.determinant() * A.inverse().transpose();
+  for (int a = 0; a < 8; ++a) {
+    const Eigen::Vector3d s(a & 1 ? 1 : -1, (a >> 1) & 1 ? 1 : -1, (a >> 2) & 1 ? 1 : -1);
+    EXPECT_LT((affine.gradient_m2[a] - cof * s * h * h / 4).norm(), 1e-12 * h * h) << "corner " << a;
+  }
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> r(-0.3 * h, 0.3 * h);
+  auto warped = unit_cell_corners(h);
+  for (auto& x : warped) x += Eigen::Vector3d(r(rng), r(rng), r(rng));
+  const TrilinearVolume cell = trilinear_volume(warped);
+  const double step = 1e-6 * h;
+  for (int a = 0; a < 8; ++a)
+    for (int k = 0; k < 3; ++k) {
+      auto plus = warped, minus = warped;
+      plus[a][k] += step;
+      minus[a][k] -= step;
+      const double fd = (trilinear_volume(plus).volume_m3 - trilinear_volume(minus).volume_m3) / (2 * step);
+      EXPECT_NEAR(cell.gradient_m2[a][k], fd, 1e-7 * h * h) << "corner " << a << " component " << k;
+    }
+}
+
+// Two cells sharing a warped face: moving that face's corners changes the two volumes by equal and
+// opposite amounts when the outer corners stay (the volume of the union depends only on its
+// boundary), so the cells tile the body without gaps or overlaps.
+TEST(DualCells, NeighbouringCellsShareTheirFace) {
+  const double h = 0.002;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> r(-0.25 * h, 0.25 * h);
+  auto lower = unit_cell_corners(h), upper = unit_cell_corners(h);
+  for (auto& x : upper) x.z() += h;
+  for (int a = 4; a < 8; ++a) {  // the shared face: lower's top (k = 1), upper's bottom (k = 0)
+    const Eigen::Vector3d move(r(rng), r(rng), r(rng));
+    lower[a] += move;
+    upper[a - 4] += move;
+  }
+  const double moved = trilinear_volume(lower).volume_m3 + trilinear_volume(upper).volume_m3;
+  EXPECT_NEAR(moved, 2 * h * h * h, 1e-13 * h * h * h);
 }
 
 }  // namespace

@@ -133,6 +133,74 @@ TEST(HyperelasticKernels, InternalForcesHaveNoNetForceOrTorque) {
   EXPECT_LT(torque.norm(), 1e-10 * scale * 0.01);  // lever arms ~1 cm
 }
 
+// The device's elastic forces are the negative gradient of the host's energy (an independent
+// implementation: Σ w_e·h³·W_iso(F_e) plus the dual cells' h³·κ_c/2·(J_c − 1)², exact trilinear
+// cell volumes), by central differences, with the hourglass springs off (they have no energy) and
+// two laws whose bulk moduli differ, so cells across the interface average them.
+TEST(HyperelasticKernels, ForcesAreTheNegativeGradientOfTheEnergy) {
+  Scene s = hyper_block(5, neo_hookean(3000, 0.499));
+  ShapeSpec inclusion;
+  inclusion.kind = ShapeSpec::Kind::Sphere;
+  inclusion.center_m = Vec3(0.004, 0.004, 0.004);
+  inclusion.radius_m = 0.0025;
+  inclusion.label = "tumour";
+  s.model.shapes.push_back(inclusion);
+  s.materials["tumour"] = ogden_two_term();
+  s.materials["tumour"].name = "tumour";
+  s.solver.hourglass = 0;
+  const test::Model m = test::make_model(s);
+  std::mt19937 rng(19);
+  std::uniform_real_distribution<double> r(-1, 1);
+  std::vector<double> u(3 * m.lattice.element_count());
+  for (double& x : u) x = 0.15 * 0.002 * r(rng);
+  const auto f = device_forces(s, m, u);
+  const HostReference host(m.lattice, m.elements, s);
+  const double step = 1e-7 * 0.002, scale = max_abs(f);
+  std::uniform_int_distribution<std::size_t> pick(0, u.size() - 1);
+  for (int sample = 0; sample < 40; ++sample) {
+    const std::size_t i = pick(rng);
+    std::vector<double> plus = u, minus = u;
+    plus[i] += step;
+    minus[i] -= step;
+    const double gradient = (host.elastic_energy(plus) - host.elastic_energy(minus)) / (2 * step);
+    EXPECT_NEAR(f[i], -gradient, 1e-6 * scale) << "element " << i / 3 << " component " << i % 3;
+  }
+}
+
+// Under a homogeneous compression every dual cell has the element's J, so the volumetric forces
+// are the pressure times the hull's area on the surface and vanish inside; a non-affine state of
+// the same boundary (interior elements swirled) keeps the cells' total volume, so it cannot lower
+// the volumetric energy below the homogeneous state's the way per-element volumes could.
+TEST(HyperelasticKernels, CellVolumesAddUpToTheBodyVolume) {
+  const Scene s = hyper_block(6, neo_hookean(3000, 0.499));
+  const test::Model m = test::make_model(s);
+  const HostReference host(m.lattice, m.elements, s);
+  const auto squeezed = field(m.lattice, [](const Vec3& X) { return Vec3(0, 0, -0.1 * X.z()); });
+  auto swirled = squeezed;
+  for (std::size_t e = 0; e < m.lattice.element_count(); ++e) {
+    const auto ijk = m.lattice.voxel_ijk(e);
+    if (std::min({ijk[0], ijk[1], ijk[2], 5 - ijk[0], 5 - ijk[1], 5 - ijk[2]}) == 0) continue;  // boundary stays
+    const double a = 0.3 * 0.002 * ((ijk[0] + ijk[1] + ijk[2]) % 2 ? 1 : -1);
+    swirled[3 * e] += a * (ijk[1] - 2.5) / 2.5;
+    swirled[3 * e + 1] -= a * (ijk[0] - 2.5) / 2.5;
+  }
+  // the isochoric energy rises (non-affine), the volumetric one is that of the whole box at J = 0.9
+  // spread over the cells: at least the homogeneous state's (Jensen), whatever the interior does
+  Scene volumetric_only = s;
+  volumetric_only.materials["soft"].poisson_ratio = 0.4999999;
+  const test::Model mv = test::make_model(volumetric_only);
+  const HostReference hv(mv.lattice, mv.elements, volumetric_only);
+  EXPECT_GE(hv.elastic_energy(swirled), hv.elastic_energy(squeezed) * (1 - 1e-9));
+  const auto f = device_forces(s, m, squeezed);
+  double interior = 0, scale = max_abs(f);
+  for (std::size_t e = 0; e < m.lattice.element_count(); ++e) {
+    const auto ijk = m.lattice.voxel_ijk(e);
+    if (std::min({ijk[0], ijk[1], ijk[2], 5 - ijk[0], 5 - ijk[1], 5 - ijk[2]}) >= 2)
+      interior = std::max(interior, Vec3(f[3 * e], f[3 * e + 1], f[3 * e + 2]).norm());
+  }
+  EXPECT_LT(interior, 1e-9 * scale) << "a homogeneous state loads only the surface layers";
+}
+
 struct Uniaxial {
   const char* law;
   double stretch;
