@@ -2,6 +2,8 @@
 
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "engine/lattice/lattice.hpp"
 
 namespace vb {

@@ -14,9 +14,8 @@ struct ElementArrays {
   /// ν = 1/4 lattice with their shear modulus, used by hourglass springs and dashpots)
   std::vector<double> youngs_modulus_pa;
   /// n, modulus setting the fastest wave for the time-step bound (Pa): E for springs (biphasic:
-  /// E·(1 + 3·c3·εc²), the stiffest tangent); for hyperelastic tissues the isochoric P-wave
-  /// modulus over the lattice's C11/E = 1.2, plus the hourglass springs (the dual cells'
-  /// volumetric stiffness is added to the rows by the time-step bound; docs/PHYSICS.md, "Time step")
+  /// E·(1 + 3·c3·εc²), the stiffest tangent); for hyperelastic tissues the P-wave modulus over
+  /// the lattice's C11/E = 1.2, plus hourglass springs
   std::vector<double> stability_modulus_pa;
   std::vector<double> mass_kg;  ///< n, density × the element's share of its body (sim/element_mass.hpp)
   std::vector<double> inverse_mass;       ///< n, 1/kg; 0 for held elements
