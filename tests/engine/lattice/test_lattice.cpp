@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -258,22 +260,30 @@ TEST(DualCells, TrilinearVolumeIsExactForAffineMapsAndItsGradientIsConsistent) {
     }
 }
 
-// Two cells sharing a warped face: moving that face's corners changes the two volumes by equal and
-// opposite amounts when the outer corners stay (the volume of the union depends only on its
-// boundary), so the cells tile the body without gaps or overlaps.
-TEST(DualCells, NeighbouringCellsShareTheirFace) {
+// Volumes add up: the 8 cells of a warped cell split at ξ, η, ζ = ½ (each again trilinear, with
+// corners on the parent's map) have the parent's volume, so cells that share a bilinear face tile
+// the body without gaps or overlaps.
+TEST(DualCells, CellVolumesAreAdditive) {
   const double h = 0.002;
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> r(-0.25 * h, 0.25 * h);
-  auto lower = unit_cell_corners(h), upper = unit_cell_corners(h);
-  for (auto& x : upper) x.z() += h;
-  for (int a = 4; a < 8; ++a) {  // the shared face: lower's top (k = 1), upper's bottom (k = 0)
-    const Eigen::Vector3d move(r(rng), r(rng), r(rng));
-    lower[a] += move;
-    upper[a - 4] += move;
+  auto p = unit_cell_corners(h);
+  for (auto& x : p) x += Eigen::Vector3d(r(rng), r(rng), r(rng));
+  const auto map = [&](double s, double t, double w) {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int a = 0; a < 8; ++a)
+      x += (a & 1 ? s : 1 - s) * ((a >> 1) & 1 ? t : 1 - t) * ((a >> 2) & 1 ? w : 1 - w) * p[a];
+    return x;
+  };
+  double children = 0;
+  for (int c = 0; c < 8; ++c) {
+    std::array<Eigen::Vector3d, 8> q;
+    for (int a = 0; a < 8; ++a)
+      q[a] = map(0.5 * ((c & 1) + (a & 1)), 0.5 * (((c >> 1) & 1) + ((a >> 1) & 1)),
+                 0.5 * (((c >> 2) & 1) + ((a >> 2) & 1)));
+    children += trilinear_volume(q).volume_m3;
   }
-  const double moved = trilinear_volume(lower).volume_m3 + trilinear_volume(upper).volume_m3;
-  EXPECT_NEAR(moved, 2 * h * h * h, 1e-13 * h * h * h);
+  EXPECT_NEAR(children, trilinear_volume(p).volume_m3, 1e-13 * h * h * h);
 }
 
 }  // namespace
