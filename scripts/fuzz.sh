@@ -16,8 +16,8 @@
 #   BUILD_DIR      CMake build folder (default build, relative to the repository root)
 #   FUZZ_SECONDS   seconds of fuzzing per target (default 15); the targets run at once
 #   FUZZ_CXX       compiler (default clang++)
-#   FUZZ_TARGETS   targets to build and run (default "fuzz_nifti fuzz_dicom_series"; fuzz_scene_file does
-#                  not link yet: the scene parser needs more of the engine than its list below)
+#   FUZZ_TARGETS   targets to build and run (default all three: fuzz_nifti fuzz_dicom_series
+#                  fuzz_scene_file)
 #
 # Targets and objects go to ${BUILD_DIR}/fuzz/ (objects are rebuilt only when a source, a header
 # it includes or the flags change). Each target fuzzes a fresh copy of tests/fuzz/corpus/<name>/
@@ -34,7 +34,7 @@ build_dir=${BUILD_DIR:-build}
 [[ $build_dir = /* ]] || build_dir=$root/$build_dir
 seconds=${FUZZ_SECONDS:-15}
 cxx=${FUZZ_CXX:-clang++}
-targets=${FUZZ_TARGETS:-fuzz_nifti fuzz_dicom_series}
+targets=${FUZZ_TARGETS:-fuzz_nifti fuzz_dicom_series fuzz_scene_file}
 out=$build_dir/fuzz
 
 fail_setup() {
@@ -59,7 +59,7 @@ common_sources=(engine/error.cpp io/atomic_file.cpp)
 declare -A target_sources=(
   [fuzz_nifti]="tests/fuzz/fuzz_nifti.cpp io/nifti_io.cpp"
   [fuzz_dicom_series]="tests/fuzz/fuzz_dicom_series.cpp io/dicom_read.cpp io/dicom_pixels.cpp io/dicom_deflate.cpp io/dicom_attributes.cpp"
-  [fuzz_scene_file]="tests/fuzz/fuzz_scene_file.cpp io/scene_file.cpp io/toml_section.cpp io/toml_text.cpp io/did_you_mean.cpp io/indenter_path_csv.cpp io/numeric_csv.cpp engine/material/default_materials.cpp engine/material/hyperelastic.cpp engine/loads/posture.cpp"
+  [fuzz_scene_file]="tests/fuzz/fuzz_scene_file.cpp io/scene_file.cpp io/toml_section.cpp io/toml_text.cpp io/did_you_mean.cpp io/indenter_path_csv.cpp io/numeric_csv.cpp engine/material/default_materials.cpp engine/material/hyperelastic.cpp engine/loads/posture.cpp io/scene_overrides.cpp"
 )
 declare -A target_corpus=([fuzz_nifti]=nifti [fuzz_dicom_series]=dicom [fuzz_scene_file]=scene)
 for t in $targets; do
