@@ -11,6 +11,8 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${VOXBREAST_SANITIZE_DIR:-$root/build-sanitize}
 tests=${VOXBREAST_SANITIZE_TESTS:-test_io test_engine}
+# -O1 with line tables: reports name file and line. (-O0 builds in 6.5 min instead of about 8 on
+# 2 cores, but test_engine then runs 7 min instead of about 1.)
 options=(-DVOXBREAST_SANITIZE=ON -DVOXBREAST_MPI=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo
   "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O1 -g1")
 command -v ninja >/dev/null && options+=(-G Ninja)

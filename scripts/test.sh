@@ -9,6 +9,11 @@ bash "$root/scripts/build.sh"
 export VOXBREAST_DEVICE=${VOXBREAST_DEVICE:-cpu}
 # Built kernels are kept between test processes (and runs) in the build folder.
 export VOXBREAST_CACHE_DIR=${VOXBREAST_CACHE_DIR:-$build/program-cache}
-cd "$build"
+status=0
 # Long validation studies and GPU-only checks are labelled and run apart (README, "Quick start").
-ctest --output-on-failure --parallel "$(nproc)" --timeout 1200 -LE "slow|validation|gpu" -E "Study\.|Gpu\."
+(cd "$build" && ctest --output-on-failure --parallel "$(nproc)" --timeout 1200 -LE "slow|validation|gpu" -E "Study\.|Gpu\.") ||
+  status=1
+# The io and engine unit tests once more, built with ASan and UBSan (float-cast-overflow included)
+# in a folder of their own: any sanitizer report fails the suite.
+bash "$root/scripts/sanitize.sh" || status=1
+exit $status
