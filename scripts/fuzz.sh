@@ -57,7 +57,7 @@ libs=(-ldcmjpls -ldcmjpeg -ldcmimage -ldcmimgle -ldcmdata -loflog -lofstd
 # Project sources each target needs (listed explicitly; keep in step with their #includes).
 common_sources=(engine/error.cpp io/atomic_file.cpp)
 declare -A target_sources=(
-  [fuzz_nifti]="tests/fuzz/fuzz_nifti.cpp io/nifti_io.cpp"
+  [fuzz_nifti]="tests/fuzz/fuzz_nifti.cpp io/nifti_io.cpp io/gzip_blocks.cpp"
   [fuzz_dicom_series]="tests/fuzz/fuzz_dicom_series.cpp io/dicom_read.cpp io/dicom_pixels.cpp io/dicom_deflate.cpp io/dicom_attributes.cpp"
   [fuzz_scene_file]="tests/fuzz/fuzz_scene_file.cpp io/scene_file.cpp io/toml_section.cpp io/toml_text.cpp io/did_you_mean.cpp io/indenter_path_csv.cpp io/numeric_csv.cpp engine/material/default_materials.cpp engine/material/hyperelastic.cpp engine/loads/posture.cpp io/scene_overrides.cpp"
 )

@@ -68,8 +68,13 @@ bool is_timing_field(const std::string& path) {
   const auto ends_with = [&](const std::string& tail) {
     return leaf.size() >= tail.size() && leaf.compare(leaf.size() - tail.size(), tail.size(), tail) == 0;
   };
-  // a fit's jacobian_timing: this run's split of its perturbed solves (a resumed fit counts afresh)
-  return ends_with("wall_time_s") || leaf.find("per_second") != std::string::npos || path.rfind("jacobian_timing.", 0) == 0;
+  if (ends_with("wall_time_s") || leaf.find("per_second") != std::string::npos) return true;
+  // a fit's jacobian_timing: this run's split of its perturbed solves (a resumed fit counts afresh);
+  // a simulation's phase times and its image outputs' seconds and memory: this machine's, this run's
+  for (const char* prefix : {"jacobian_timing.", "timings.", "image_outputs.step_seconds.",
+                             "image_outputs.step_cpu_seconds.", "image_outputs.host_memory."})
+    if (path.rfind(prefix, 0) == 0) return true;
+  return false;
 }
 
 std::string scalar_text(const nlohmann::json& v) {
