@@ -14,22 +14,7 @@ web=$root/apps/web
 [[ -x ${CHROMIUM:-/usr/bin/chromium} ]] || { echo "SKIP: chromium is not installed (scripts/setup.sh installs it)"; exit 77; }
 [[ -d $web/node_modules/ws ]] || { echo "SKIP: apps/web/node_modules is missing (scripts/setup.sh runs npm ci)"; exit 77; }
 py=/usr/bin/python3
-servers=()
-trap 'for p in "${servers[@]}"; do kill "$p" 2>/dev/null; done; rm -rf "$work"' EXIT
-start_serve() {
-  local log=$work/serve-$RANDOM.log
-  "$bin" serve "$@" >"$log" 2>&1 &
-  servers+=($!)
-  url=""
-  for _ in $(seq 300); do
-    url=$(grep -o 'http://[^ ]*' "$log" | head -1)
-    [[ -n $url ]] && return 0
-    kill -0 "${servers[-1]}" 2>/dev/null || break
-    sleep 0.1
-  done
-  cat "$log"
-  return 1
-}
+start_serve() { start_server 300 serve "$@"; }
 
 { block_scene; printf '[solver]\ncheck_every = 50\n'; } >"$work/block.toml"
 if start_serve "$work/block.toml" --port 0 --pause-at-step 1000; then

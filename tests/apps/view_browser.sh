@@ -15,24 +15,8 @@ chromium=${CHROMIUM:-/usr/bin/chromium}
 [[ -x $chromium ]] || { echo "SKIP: $chromium is not installed (scripts/setup.sh installs Debian's chromium)"; exit 77; }
 [[ -d $web/node_modules/puppeteer-core ]] || { echo "SKIP: apps/web/node_modules is missing (scripts/setup.sh runs npm ci)"; exit 77; }
 py=/usr/bin/python3
-servers=()
-trap 'for p in "${servers[@]}"; do kill "$p" 2>/dev/null; done; rm -rf "$work"' EXIT
-
 # Starts `voxbreast view ARGS...` in the background; sets $url from the line it prints.
-start_view() {
-  local log=$work/view-$RANDOM.log
-  "$bin" view "$@" >"$log" 2>&1 &
-  servers+=($!)
-  url=""
-  for _ in $(seq 100); do
-    url=$(grep -o 'http://[^ ]*' "$log" | head -1)
-    [[ -n $url ]] && return 0
-    kill -0 "${servers[-1]}" 2>/dev/null || break
-    sleep 0.1
-  done
-  cat "$log"
-  return 1
-}
+start_view() { start_server 100 view "$@"; }
 status_of() { curl -s -o "$work/body" -w '%{http_code}' --path-as-is "$@"; }
 
 # --- a small CT simulation: prone, 6 mm lattice, surfaces and frames, a tracked point
